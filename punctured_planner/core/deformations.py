@@ -1,0 +1,71 @@
+"""The deformations that carry any configuration onto the axis: D, S and phi.
+
+* D, the desingularisation (paper, Section 3): robot with paper index j = r + i
+  (i = 1..k) moves by t (j - 1) eps(C) e1; only for cp(C) < k + r.
+* S, our spreading leg (design.md section 3, variant 'spread'): robots move
+  along e1 only, keeping their order and their interval between obstacle
+  projections, to the nearest positions that are `min_spacing` apart.
+* phi, the projection onto the axis (paper, equation (3.2)): x + t (p(x) e1 - x).
+"""
+
+import numpy as np
+from scipy.optimize import isotonic_regression
+
+
+def desingularizing_shift(projection_counts, eps, robot_count, obstacle_count):
+    """Return the (n, k) e1 shift of D(C, 1): (j - 1) eps(C) for paper index j, 0 in A_{k+r}."""
+    indices = obstacle_count + np.arange(robot_count)
+    singular = projection_counts < robot_count + obstacle_count
+    return np.where(singular[:, None], indices[None, :] * eps[:, None], 0.0)
+
+
+def desingularize(configurations, shift, e1):
+    """Return D(C, 1) = C + shift e1 for configurations (n, k, d) and shifts (n, k)."""
+    return configurations + shift[..., None] * e1
+
+
+def _interval_spacing(lengths, counts, min_spacing):
+    """Return the spacing used in each interval: min_spacing, or evenly what fits."""
+    with np.errstate(divide='ignore', invalid='ignore'):
+        return np.minimum(min_spacing, lengths / (counts + 1))
+
+
+def spread(projections, sorted_obstacle_projections, min_spacing):
+    """Return S(C, 1) projections: the nearest order-preserving spaced positions.
+
+    projections (n, k) are pairwise distinct and distinct from the obstacle
+    projections (they come out of D). In each interval between consecutive
+    obstacle projections, with m robots and spacing g = min(min_spacing,
+    length / (m + 1)), the robots move to the Euclidean projection of their
+    positions onto {y : y_1 >= a + g, y_{i+1} - y_i >= g, y_m <= b - g}. With
+    z_i = y_i - i g this is isotonic regression with common bounds
+    [a, b - (m + 1) g], solved by clipping the unconstrained isotonic fit. A
+    projection onto a convex set is 1-Lipschitz, and order and counts are
+    locally constant on A_{k+r}, so S is continuous there.
+    Returns (spread projections (n, k), spacing used per robot (n, k)).
+    """
+    n, k = projections.shape
+    bounds = np.concatenate([[-np.inf], sorted_obstacle_projections, [np.inf]])
+    interval = np.searchsorted(sorted_obstacle_projections, projections)
+    lower, upper = bounds[interval], bounds[interval + 1]
+    # One group per (configuration, interval); robots sorted inside each group.
+    group = np.arange(n)[:, None] * bounds.size + interval
+    order = np.lexsort((projections.ravel(), group.ravel()))
+    group_sorted = group.ravel()[order]
+    starts = np.flatnonzero(np.r_[True, np.diff(group_sorted) != 0])
+    sizes = np.diff(np.r_[starts, group_sorted.size])
+    rank = np.arange(group_sorted.size) - np.repeat(starts, sizes)
+    count = np.repeat(sizes, sizes)
+    low, high = lower.ravel()[order], upper.ravel()[order]
+    spacing = _interval_spacing(high - low, count, min_spacing)
+    z = projections.ravel()[order] - (rank + 1) * spacing
+    for start, size in zip(starts[sizes > 1], sizes[sizes > 1]):
+        block = slice(start, start + size)
+        z[block] = isotonic_regression(z[block]).x
+    z = np.clip(z, low, high - (count + 1) * spacing)
+    result = np.empty(n * k)
+    result[order] = z + (rank + 1) * spacing
+    used = np.empty(n * k)
+    used[order] = spacing
+    return result.reshape(n, k), used.reshape(n, k)
+

@@ -1,0 +1,176 @@
+"""The plan: the sequential section sigma_{j_1..j_n} as exact breakpoints (paper, Section 4).
+
+`plan` runs, for every configuration C_m: the projection count cp(C_m), the
+desingularisation D (only below the top stratum), the spreading leg S
+(variant 'spread'), the projection phi onto the axis; then composes Gamma
+between consecutive axis configurations as in Remark 2.3. Every leg is linear
+and all robots switch legs together, so the motion is the piecewise-linear
+interpolation of its breakpoints, stored exactly.
+"""
+
+from functools import cached_property
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from .certificate import certify
+from .complexity import domain_range, sequential_complexity
+from .deformations import desingularize, desingularizing_shift, spread
+from .errors import ErrorCode, PlanningError
+from .sections import (compose, lane_heights, PAPER_FRACTIONS, PAPER_LEGS, segment_times,
+                       SPREAD_FRACTIONS, SPREAD_LEGS)
+from .strata import epsilon, projection_count
+from .timing import breakpoint_stamps, resample
+from .validation import validate_configurations
+
+
+class Plan:
+    """A synchronous collision-free motion through C_1..C_n, stored as breakpoints."""
+
+    def __init__(self, workspace, configurations, times, positions, leg_names,
+                 projection_counts, lanes, spacing):
+        """Keep the breakpoints and the data the derived attributes need."""
+        n, k, d = configurations.shape
+        r = workspace.obstacle_count
+        self.workspace = workspace
+        self.configurations = configurations
+        self.times = times
+        self.positions = positions
+        self.leg_names = leg_names
+        self.waypoint_indices = np.arange(n) * (len(leg_names) // (n - 1))
+        self.projection_counts = projection_counts
+        self.domain = int(projection_counts.sum())
+        low, high = domain_range(n, k, r)
+        self.domain_range = (low, high)
+        self.domain_index = self.domain - low
+        self.domain_count = high - low + 1
+        self.sequential_complexity = sequential_complexity(n, k, r, d)
+        self.optimal = self.domain_count == self.sequential_complexity
+        self.frame = workspace.frame
+        self.variant = workspace.variant
+        self.lanes = lanes
+        self._spacing = spacing
+
+    @cached_property
+    def clearance(self):
+        """Return the exact Clearance certificate (computed once, on first use)."""
+        return certify(self.times, self.positions, self.workspace.obstacles)
+
+    @property
+    def min_clearance(self):
+        """Return the exact minimum distance over all robot and robot-obstacle pairs."""
+        return self.clearance.distance
+
+    @cached_property
+    def input_separation(self):
+        """Return the smallest robot-robot or robot-obstacle distance in any C_m."""
+        obstacles = self.workspace.obstacles
+        smallest = np.inf
+        for configuration in self.configurations:
+            if len(configuration) > 1:
+                smallest = min(smallest, cKDTree(configuration).query(configuration, k=2)[0][:, 1]
+                               .min())
+            if len(obstacles):
+                smallest = min(smallest, cKDTree(obstacles).query(configuration)[0].min())
+        return float(smallest)
+
+    @cached_property
+    def clearance_bound(self):
+        """Return a lower bound on min_clearance for the 'spread' variant (None for 'paper').
+
+        bound = min(s / (k + r) if some C_m is singular else s, g, lane_spacing):
+        s is the input separation; D moves the robots of a singular C_m by less
+        than the smallest projection gap, so its legs keep s / (k + r); S and
+        the axis legs keep the spacing g actually used (min_spacing, or less in
+        an interval too short for its robots); the slides run in lanes
+        lane_spacing apart and beyond the obstacles.
+        """
+        if self.variant != 'spread':
+            return None
+        n, k = self.configurations.shape[:2]
+        singular = np.any(self.projection_counts < k + self.workspace.obstacle_count)
+        separation = self.input_separation
+        if singular:
+            separation /= k + self.workspace.obstacle_count
+        return float(min(separation, self._spacing.min(), self.workspace.lane_spacing))
+
+    def position(self, tau):
+        """Return the robot positions at parameter(s) tau in [0, 1]: (k, d) or (..., k, d)."""
+        tau = np.asarray(tau, dtype=float)
+        leg = np.clip(np.searchsorted(self.times, tau, side='right') - 1, 0, self.times.size - 2)
+        start, end = self.times[leg], self.times[leg + 1]
+        with np.errstate(divide='ignore', invalid='ignore'):
+            fraction = np.where(end > start, (tau - start) / (end - start), 0.0)
+        fraction = np.clip(fraction, 0.0, 1.0)[..., None, None]
+        return self.positions[leg] + fraction * (self.positions[leg + 1] - self.positions[leg])
+
+    def stamps(self, max_speed):
+        """Return (V,) seconds from the start at each breakpoint, fastest robot at max_speed."""
+        return breakpoint_stamps(self.positions, max_speed)
+
+    def duration(self, max_speed):
+        """Return the duration in seconds of the whole motion at max_speed."""
+        return float(self.stamps(max_speed)[-1])
+
+    def sample(self, samples_per_leg, max_speed=None):
+        """Return (values, positions, is_breakpoint) with extra samples inside every leg.
+
+        values are stamps in seconds when max_speed is given, else parameters tau.
+        """
+        values = self.times if max_speed is None else self.stamps(max_speed)
+        return resample(values, self.positions, samples_per_leg)
+
+
+def plan(workspace, configurations, certify=True):
+    """Return the Plan through configurations (n, k, d) in workspace, or raise PlanningError.
+
+    With certify (the default) the exact clearance is computed at once and a
+    plan below workspace.required_clearance is refused.
+    """
+    configurations = validate_configurations(configurations, workspace.obstacles)
+    n, k, d = configurations.shape
+    r = workspace.obstacle_count
+    frame = workspace.frame
+    projections = frame.project(configurations)
+    counts = projection_count(projections, workspace.obstacle_projections)
+    eps = epsilon(projections, workspace.obstacle_projections, workspace.lane_spacing)
+    shift = desingularizing_shift(counts, eps, k, r)
+    desingularized = desingularize(configurations, shift, frame.e1)
+    projections = projections + shift
+    stages = [configurations, desingularized]
+    spacing = np.full((n, k), np.inf)
+    if workspace.variant == 'spread':
+        spread_projections, spacing = spread(projections, workspace.sorted_obstacle_projections,
+                                             workspace.min_spacing)
+        stages.append(desingularized + (spread_projections - projections)[..., None] * frame.e1)
+        projections = spread_projections
+        fractions, legs = SPREAD_FRACTIONS, SPREAD_LEGS
+    else:
+        fractions, legs = PAPER_FRACTIONS, PAPER_LEGS
+    stages.append(frame.axis_points(projections))
+    lanes = lane_heights(k, r, workspace.lane_spacing, workspace.lane_base, workspace.variant)
+    positions = compose(stages, lanes, frame.e2)
+    result = Plan(workspace, configurations, segment_times(n, fractions), positions,
+                  legs * (n - 1), counts, lanes, spacing)
+    if certify:
+        _check_required_clearance(result)
+    return result
+
+
+def _check_required_clearance(result):
+    """Raise CLEARANCE_BELOW_REQUIRED if the certified clearance is below the requirement."""
+    required = result.workspace.required_clearance
+    clearance = result.clearance
+    if clearance.distance >= required:
+        return
+    a, b = clearance.indices
+    what = (f'robots {a} and {b}' if clearance.kind == 'robots'
+            else f'robot {a} and obstacle {b}')
+    segment = clearance.leg // (len(result.leg_names) // (result.configurations.shape[0] - 1))
+    raise PlanningError(
+        ErrorCode.CLEARANCE_BELOW_REQUIRED,
+        f'{what} come within {clearance.distance:.6g} < required {required:.6g} on leg '
+        f'{clearance.leg} ({result.leg_names[clearance.leg]} of segment C_{segment + 1} -> '
+        f'C_{segment + 2}) at tau {clearance.tau:.6g}',
+        configuration=segment, robots=[a] if clearance.kind == 'obstacle' else [a, b],
+        obstacle=b if clearance.kind == 'obstacle' else None)

@@ -1,0 +1,61 @@
+"""The section Gamma on axis configurations and the sequential composition (Remark 2.3).
+
+Gamma(L, L') (paper, equation (3.1)): robot with paper index i lifts to height
+i along e2, slides to L'_i + i e2, and drops; a third of the time each. The
+n-th sequential section concatenates Gamma(L_m, L_{m+1}) and, by Remark 2.3,
+wraps each segment in the deformations H(C_m) forward and H(C_{m+1}) backward.
+"""
+
+import numpy as np
+
+# Breakpoint fractions of one segment [tau_m, tau_{m+1}]: the first third is
+# H(C_m) forward with its legs of equal length, the middle third is Gamma
+# (lift, slide, drop: a ninth each), the last third is H(C_{m+1}) backward.
+PAPER_FRACTIONS = (0.0, 1 / 6, 1 / 3, 4 / 9, 5 / 9, 2 / 3, 5 / 6, 1.0)
+SPREAD_FRACTIONS = (0.0, 1 / 9, 2 / 9, 1 / 3, 4 / 9, 5 / 9, 2 / 3, 7 / 9, 8 / 9, 1.0)
+
+PAPER_LEGS = ('D', 'phi', 'lift', 'slide', 'drop', 'phi^-1', 'D^-1')
+SPREAD_LEGS = ('D', 'S', 'phi', 'lift', 'slide', 'drop', 'phi^-1', 'S^-1', 'D^-1')
+
+
+def lane_heights(robot_count, obstacle_count, lane_spacing, lane_base, variant):
+    """Return the (k,) e2 heights of the lanes above the axis.
+
+    Paper: robot i (1-based) has paper index r + i and lane height
+    (r + i) lane_spacing, exactly the paper's heights for lane_spacing 1 and
+    obstacles on the axis. Spread: lanes lane_spacing apart starting
+    lane_spacing beyond the highest obstacle. Either way above `lane_base`,
+    the highest obstacle e2 offset, so the slides never meet an obstacle.
+    """
+    first = obstacle_count + 1 if variant == 'paper' else 1
+    return lane_base + (first + np.arange(robot_count)) * lane_spacing
+
+
+def segment_times(configuration_count, fractions):
+    """Return breakpoint parameters: tau_m + (tau_{m+1} - tau_m) f for each segment.
+
+    Waypoints sit at tau_m = (m - 1) / (n - 1) (paper, equation (2.1)); the
+    segments share their end points, so there are (n - 1) (len(f) - 1) + 1 times.
+    """
+    tau = np.arange(configuration_count) / (configuration_count - 1)
+    times = tau[:-1, None] + np.diff(tau)[:, None] * np.asarray(fractions)[None, :]
+    return np.concatenate([times[:, :-1].ravel(), tau[-1:]])
+
+
+def compose(deformation_stages, lanes, e2):
+    """Return the (V, k, d) breakpoint positions of the sequential section.
+
+    deformation_stages lists (n, k, d) arrays H_0 = C, H_1, ..., H_s = L (the
+    configurations after each deformation leg, ending on the axis). Segment m
+    runs H(C_m) forward, Gamma(L_m, L_{m+1}), then H(C_{m+1}) backward.
+    """
+    axis = deformation_stages[-1]
+    lifted = axis + lanes[None, :, None] * e2
+    forward = deformation_stages
+    backward = deformation_stages[::-1]
+    segment = ([stage[:-1] for stage in forward]
+               + [lifted[:-1], lifted[1:]]
+               + [stage[1:] for stage in backward[:-1]])
+    stacked = np.stack(segment, axis=1)
+    n, k, d = deformation_stages[0].shape
+    return np.concatenate([stacked.reshape(-1, k, d), deformation_stages[0][-1:]])
