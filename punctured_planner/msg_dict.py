@@ -1,0 +1,114 @@
+"""
+Plain-data (YAML/JSON) <-> ROS message conversion without rosidl_runtime_py.
+
+rosidl_runtime_py (what ``ros2 service call`` uses) is not on PyPI, so this
+module does the same small job: it fills a message from nested dicts and lists
+in the shape ``ros2 service call`` accepts, and turns a message back into
+plain data.
+"""
+
+import array
+import importlib
+import math
+import re
+
+_SEQUENCE = re.compile(r'^sequence<(?P<inner>[^,>]+)(?:, *\d+)?>$')
+_ARRAY = re.compile(r'^(?P<inner>[^\[]+)\[\d+\]$')
+
+
+def _is_message(value):
+    return hasattr(type(value), 'get_fields_and_field_types')
+
+
+def _message_class(type_name):
+    """Return the class for a field type such as ``geometry_msgs/PoseArray``."""
+    package, _, name = type_name.partition('/')
+    if not name:
+        return None
+    return getattr(importlib.import_module(package + '.msg'), name)
+
+
+def _element_type(type_name):
+    for pattern in (_SEQUENCE, _ARRAY):
+        match = pattern.match(type_name)
+        if match:
+            return match.group('inner').strip()
+    return None
+
+
+def _convert_scalar(type_name, value, where):
+    if type_name == 'boolean':
+        if not isinstance(value, bool):
+            raise ValueError('%s: expected true or false, got %r' % (where, value))
+        return value
+    if type_name in ('float', 'double'):
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ValueError('%s: expected a number, got %r' % (where, value))
+        return float(value)
+    if 'int' in type_name or type_name in ('octet', 'char'):
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise ValueError('%s: expected an integer, got %r' % (where, value))
+        return value
+    if 'string' in type_name:
+        if not isinstance(value, str):
+            raise ValueError('%s: expected a string, got %r' % (where, value))
+        return value
+    return value
+
+
+def _convert(type_name, current, value, where):
+    element = _element_type(type_name)
+    if element is not None:
+        if not isinstance(value, (list, tuple)):
+            raise ValueError('%s: expected a list, got %r' % (where, value))
+        cls = _message_class(element)
+        if cls is not None:
+            return [fill_message(cls(), item, '%s[%d]' % (where, i))
+                    for i, item in enumerate(value)]
+        return [_convert_scalar(element, item, '%s[%d]' % (where, i))
+                for i, item in enumerate(value)]
+    if _is_message(current):
+        return fill_message(current, value, where)
+    return _convert_scalar(type_name, value, where)
+
+
+def fill_message(msg, data, where='request'):
+    """
+    Set the fields of ``msg`` from a dict (nested dicts for nested messages).
+
+    Fields not named keep their defaults. Unknown field names and values of the
+    wrong kind raise ValueError naming the field.
+    """
+    if data is None:
+        return msg
+    if not isinstance(data, dict):
+        raise ValueError('%s: expected a mapping of field names, got %r' % (where, data))
+    fields = msg.get_fields_and_field_types()
+    for key, value in data.items():
+        if key not in fields:
+            raise ValueError('%s: unknown field %r (fields: %s)'
+                             % (where, key, ', '.join(fields)))
+        field_where = '%s.%s' % (where, key)
+        setattr(msg, key, _convert(fields[key], getattr(msg, key), value, field_where))
+    return msg
+
+
+def message_to_dict(msg):
+    """Return ``msg`` as plain dicts, lists and scalars (YAML/JSON friendly)."""
+    if _is_message(msg):
+        return {name: message_to_dict(getattr(msg, name))
+                for name in msg.get_fields_and_field_types()}
+    if isinstance(msg, (list, tuple, array.array)):
+        return [message_to_dict(item) for item in msg]
+    if hasattr(msg, 'tolist'):
+        return msg.tolist()
+    if isinstance(msg, float) and not math.isfinite(msg):
+        return str(msg)
+    return msg
+
+
+def constant_names(cls, value):
+    """Return the names of the integer constants of ``cls`` equal to ``value``."""
+    return [name for name in dir(cls)
+            if name.isupper() and not name.startswith('_')
+            and isinstance(getattr(cls, name), int) and getattr(cls, name) == value]
