@@ -154,15 +154,15 @@ def ros_client():
 class NodeProcess:
     """A planner node started from its installed console script."""
 
-    def __init__(self, args, env, log_path, namespace):
-        """Start ``args`` with ``env``; stdout and stderr go to ``log_path``."""
+    def __init__(self, args, env, log_path, namespace, cwd=REPO_ROOT):
+        """Start ``args`` with ``env`` in ``cwd``; stdout and stderr go to ``log_path``."""
         self.args = list(args)
         self.namespace = namespace
         self.log_path = log_path
         self._log = open(log_path, 'wb')
         self.proc = subprocess.Popen(
             self.args, env=env, stdout=self._log, stderr=subprocess.STDOUT,
-            stdin=subprocess.DEVNULL, cwd=REPO_ROOT)
+            stdin=subprocess.DEVNULL, cwd=cwd)
 
     def name(self, relative):
         """Return the absolute name of a relative topic or service of the node."""
