@@ -1,4 +1,5 @@
-"""The math core's own speed figures (issue 3), measured warm and in process.
+"""
+The math core's own speed figures (issue 3), measured warm and in process.
 
 Every figure is the median of many timed calls (time.perf_counter); a call
 that takes microseconds is timed in batches and divided by the batch size.
@@ -55,7 +56,8 @@ def workspace_and_query(seed, n, k, r, d, variant='paper'):
 
 
 def median_time(call, budget=0.5, min_repeats=7, max_repeats=201):
-    """Return (median seconds per call, repeats) over timed batches of call().
+    """
+    Return (median seconds per call, repeats) over timed batches of call().
 
     The batch size is chosen so one batch takes about a millisecond; batches
     repeat until `budget` seconds pass (at least min_repeats of them).
@@ -232,59 +234,47 @@ def scaling_rows(figures):
 
 
 def stage_breakdown(budget=0.3):
-    """Return (stage, median seconds) for the stages of one k=8 r=3 n=3 d=2 certified plan."""
-    from punctured_planner.core import deformations, sections, strata, validation
+    """Return (stage, median seconds) of one k=8 r=3 n=3 d=2 plan, through the public API."""
     workspace, query = workspace_and_query(3, 3, 8, 3, 2)
     motion = plan(workspace, query, certify=False)
-    frame = workspace.frame
-    projections = frame.project(query)
-    counts = strata.projection_count(projections, workspace.obstacle_projections)
-    eps = strata.epsilon(projections, workspace.obstacle_projections, 1.0)
-    shift = deformations.desingularizing_shift(counts, eps, 8, 3)
-    stages = [query, deformations.desingularize(query, shift, frame.e1),
-              frame.axis_points(projections + shift)]
-    lanes = sections.lane_heights(8, 3, 1.0, workspace.lane_base, 'paper')
     calls = [
-        ('validate_configurations',
-         lambda: validation.validate_configurations(query, workspace.obstacles)),
-        ('project + projection_count + epsilon', lambda: (
-            strata.projection_count(frame.project(query), workspace.obstacle_projections),
-            strata.epsilon(projections, workspace.obstacle_projections, 1.0))),
-        ('desingularize + axis_points', lambda: (
-            deformations.desingularize(query, deformations.desingularizing_shift(
-                counts, eps, 8, 3), frame.e1), frame.axis_points(projections + shift))),
-        ('lane_heights + compose + segment_times', lambda: (
-            sections.compose(stages, lanes, frame.e2),
-            sections.segment_times(3, sections.PAPER_FRACTIONS))),
-        ('certify (robot pairs + obstacles)',
+        ('Workspace(obstacles) (once per obstacle set)',
+         lambda: Workspace(workspace.obstacles)),
+        ('plan(certify=False)', lambda: plan(workspace, query, certify=False)),
+        ('certify(times, positions, obstacles)',
          lambda: certify(motion.times, motion.positions, workspace.obstacles)),
-        ('whole plan(certify=True)', lambda: plan(workspace, query)),
+        ('plan(certify=True)', lambda: plan(workspace, query)),
     ]
     return [(name, median_time(call, budget)[0]) for name, call in calls]
 
 
-def profile_text(call, repeats, lines=14):
-    """Return cProfile's top functions by own time over `repeats` calls."""
+def profile_text(call, repeats, lines=14, sort='tottime', restrict=None):
+    """Return cProfile's top functions (by `sort`, matching `restrict`) over repeated calls."""
     profiler = cProfile.Profile()
     profiler.enable()
     for _ in range(repeats):
         call()
     profiler.disable()
     out = io.StringIO()
-    pstats.Stats(profiler, stream=out).sort_stats('tottime').print_stats(lines)
+    stats = pstats.Stats(profiler, stream=out).sort_stats(sort)
+    stats.print_stats(*([restrict] if restrict else []), lines)
     text = out.getvalue()
     return text[text.find('ncalls'):].rstrip()
 
 
 def profiles():
-    """Return {name: cProfile text} for the two figures that miss their targets."""
+    """Return {name: cProfile text} for the small certified plan and a large certification."""
     workspace, query = workspace_and_query(3, 3, 8, 3, 2)
+    stages = profile_text(lambda: plan(workspace, query), 2000, sort='cumulative',
+                          restrict='punctured_planner')
     small = profile_text(lambda: plan(workspace, query), 2000)
     workspace, query = workspace_and_query(12, 10, 1000, 3, 2)
     motion = plan(workspace, query, certify=False)
     large = profile_text(lambda: certify(motion.times, motion.positions,
                                          workspace.obstacles), 1, lines=8)
-    return {'plan k=8 r=3 n=3 d=2 certified, 2000 calls': small,
+    return {'plan k=8 r=3 n=3 d=2 certified, 2000 calls, core functions by inclusive time':
+            stages,
+            'plan k=8 r=3 n=3 d=2 certified, 2000 calls, by own time': small,
             'certify k=1000 n=10, one call': large}
 
 
@@ -300,7 +290,7 @@ def format_table(rows):
 
 def main(argv=None):
     """Print the core speed figures (and profiles with --profile)."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.strip().splitlines()[0])
     parser.add_argument('--quick', action='store_true', help='shorter budget per figure')
     parser.add_argument('--profile', action='store_true', help='print cProfile output too')
     args = parser.parse_args(argv)
@@ -310,8 +300,8 @@ def main(argv=None):
     print(format_table(scaling_rows(figures)))
     if args.profile:
         print()
-        print(format_table([('stage', 'median')] + [(name, _seconds(seconds)) for
-                                                     name, seconds in stage_breakdown()]))
+        stages = [(name, _seconds(seconds)) for name, seconds in stage_breakdown()]
+        print(format_table([('stage', 'median')] + stages))
         for name, text in profiles().items():
             print(f'\n{name}\n{text}')
     return 0
