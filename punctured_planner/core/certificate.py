@@ -5,12 +5,21 @@ of two robots (or of a robot and a fixed obstacle) is r(t) = r0 + t v on
 t in [0, 1] and its minimum norm is reached at t* = clip(-<r0, v> / <v, v>, 0, 1).
 Evaluating that closed form for every leg and every pair gives the exact
 minimum distance over the whole motion (design.md section 2), not a sample.
+
+For many robots the pairs are pruned first, exactly: the closest pair over
+all breakpoints gives an upper bound U on the answer, and a pair whose
+coordinate ranges over a leg stay more than U apart on some axis cannot beat
+it. A sort along the best axis (sweep and prune) finds the other pairs.
 """
 
 from dataclasses import dataclass
-
 import numpy as np
+from scipy.spatial import cKDTree
 
+from .pairs import pair_difference_matrix, point_pairs
+
+# Up to this many robots every pair is evaluated on every leg (cheapest there).
+_DIRECT_ROBOTS = 64
 # Elements of (legs x pairs x d) arrays handled per chunk: bounds peak memory.
 _CHUNK_ELEMENTS = 1 << 22
 
@@ -34,16 +43,92 @@ class Clearance:
 
 
 def segment_minimum(start, velocity):
-    """Return (min distance, t*) of |start + t velocity| over t in [0, 1], elementwise.
+    """Return (min squared distance, t*) of |start + t velocity| over t in [0, 1], elementwise.
 
-    start and velocity have shape (..., d); the result has shape (...).
+    start and velocity have shape (..., d); the result has shape (...). The
+    distance is taken from the closest point itself, not from |r0|^2 - <r0, v>^2
+    / |v|^2, which cancels catastrophically when robots nearly touch.
     """
     speed2 = np.einsum('...i,...i->...', velocity, velocity)
-    along = np.einsum('...i,...i->...', start, velocity)
-    with np.errstate(divide='ignore', invalid='ignore'):
-        t = np.where(speed2 > 0, np.clip(-along / speed2, 0.0, 1.0), 0.0)
-    closest = start + t[..., None] * velocity
-    return np.sqrt(np.einsum('...i,...i->...', closest, closest)), t
+    t = np.einsum('...i,...i->...', start, velocity)
+    np.divide(t, speed2, out=t, where=speed2 > 0)
+    np.negative(t, out=t)
+    np.maximum(t, 0.0, out=t)
+    np.minimum(t, 1.0, out=t)
+    closest = t[..., None] * velocity
+    closest += start
+    return np.einsum('...i,...i->...', closest, closest), t
+
+
+def _argmin_over_legs(start, end, legs):
+    """Return (distance, leg, pair, fraction) of the smallest segment minimum."""
+    squared, fractions = segment_minimum(start, end - start)
+    leg, pair = np.unravel_index(int(np.argmin(squared)), squared.shape)
+    return (float(np.sqrt(squared[leg, pair])), int(legs[leg]), int(pair),
+            float(fractions[leg, pair]))
+
+
+def _pairs_minimum(points, legs, a, b):
+    """Return (distance, leg, pair, fraction) of the closest pair (a[i], b[i]) over legs."""
+    best = (np.inf, 0, 0, 0.0)
+    step = max(1, _CHUNK_ELEMENTS // max(1, a.size * points.shape[2]))
+    for first in range(0, legs.size, step):
+        chunk = legs[first:first + step]
+        start = points[chunk][:, a] - points[chunk][:, b]
+        end = points[chunk + 1][:, a] - points[chunk + 1][:, b]
+        best = min(best, _argmin_over_legs(start, end, chunk), key=lambda item: item[0])
+    return best
+
+
+def _direct_minimum(points, robot_count, obstacle_count):
+    """Return (distance, leg, pair, fraction) over every pair and every leg at once."""
+    relative = pair_difference_matrix(robot_count, obstacle_count) @ points
+    return _argmin_over_legs(relative[:-1], relative[1:], np.arange(points.shape[0] - 1))
+
+
+def _breakpoint_bound(positions, obstacles):
+    """Return an upper bound on the clearance: the closest pair over all breakpoints."""
+    bound = np.inf
+    obstacle_tree = cKDTree(obstacles) if len(obstacles) else None
+    for configuration in positions:
+        bound = min(bound, cKDTree(configuration).query(configuration, k=2)[0][:, 1].min())
+        if obstacle_tree is not None:
+            bound = min(bound, obstacle_tree.query(configuration)[0].min())
+    return bound
+
+
+def _sweep_pairs(start, end, bound):
+    """Return robot pairs (a, b) whose coordinate ranges over one leg come within bound.
+
+    Sorting the ranges' lower ends along the axis that leaves the fewest pairs,
+    robot i is paired with the robots after it whose lower end is at most
+    hi_i + bound. Every other pair stays more than bound apart on that axis.
+    """
+    low, high = np.minimum(start, end), np.maximum(start, end)
+    best = None
+    for axis in range(start.shape[1]):
+        order = np.argsort(low[:, axis], kind='stable')
+        ends = np.searchsorted(low[order, axis], high[order, axis] + bound, side='right')
+        counts = np.maximum(ends - np.arange(order.size) - 1, 0)
+        if best is None or counts.sum() < best[2].sum():
+            best = (order, ends, counts)
+    order, ends, counts = best
+    first = np.repeat(np.arange(order.size), counts)
+    offsets = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
+    return order[first], order[first + 1 + offsets]
+
+
+def _pruned_robot_minimum(positions, legs, bound):
+    """Return (distance, leg, a, b, fraction) of the closest robot pair, pruning by sweep."""
+    best = (np.inf, 0, 0, 0, 0.0)
+    for leg in legs:
+        a, b = _sweep_pairs(positions[leg], positions[leg + 1], bound)
+        if a.size == 0:
+            continue
+        distance, _, pair, fraction = _pairs_minimum(positions, np.array([leg]), a, b)
+        if distance < best[0]:
+            best = (distance, int(leg), int(a[pair]), int(b[pair]), fraction)
+    return best
 
 
 def _moving_legs(positions):
@@ -52,58 +137,40 @@ def _moving_legs(positions):
     return moving if moving.size else np.array([0])
 
 
-def _best(distances, fractions, legs, pair_a, pair_b):
-    """Return (distance, leg, a, b, fraction) at the argmin of (legs, pairs) distances."""
-    flat = int(np.argmin(distances))
-    leg, pair = np.unravel_index(flat, distances.shape)
-    return (float(distances[leg, pair]), int(legs[leg]), int(pair_a[pair]),
-            int(pair_b[pair]), float(fractions[leg, pair]))
-
-
-def robot_pair_minimum(positions, legs):
-    """Return (distance, leg, a, b, fraction) of the closest robot pair over the given legs."""
-    k, d = positions.shape[1:]
-    a, b = np.triu_indices(k, 1)
+def _closest(positions, obstacles):
+    """Return (distance, leg, first, second, fraction); second >= k names obstacle second - k."""
+    v, k, d = positions.shape
+    r = len(obstacles)
+    points = np.concatenate([positions, np.broadcast_to(obstacles, (v, r, d))], axis=1)
+    a, b = point_pairs(k, r)
+    if k <= _DIRECT_ROBOTS:
+        if a.size * v * d <= _CHUNK_ELEMENTS:
+            distance, leg, pair, fraction = _direct_minimum(points, k, r)
+        else:
+            distance, leg, pair, fraction = _pairs_minimum(points, np.arange(v - 1), a, b)
+        return distance, leg, int(a[pair]), int(b[pair]), fraction
+    # Many robots: every robot-obstacle pair, and the robot pairs the sweep keeps.
+    legs = _moving_legs(positions)
     best = (np.inf, 0, 0, 0, 0.0)
-    step = max(1, _CHUNK_ELEMENTS // max(1, a.size * d))
-    for first in range(0, legs.size, step):
-        chunk = legs[first:first + step]
-        start = positions[chunk][:, a] - positions[chunk][:, b]
-        end = positions[chunk + 1][:, a] - positions[chunk + 1][:, b]
-        distances, fractions = segment_minimum(start, end - start)
-        candidate = _best(distances, fractions, chunk, a, b)
-        best = min(best, candidate, key=lambda item: item[0])
-    return best
-
-
-def obstacle_minimum(positions, legs, obstacles):
-    """Return (distance, leg, robot, obstacle, fraction) of the closest robot-obstacle pair."""
-    k, d = positions.shape[1:]
-    robot, obstacle = (g.ravel() for g in np.meshgrid(np.arange(k), np.arange(len(obstacles)),
-                                                       indexing='ij'))
-    start = positions[legs][:, robot] - obstacles[obstacle]
-    velocity = positions[legs + 1][:, robot] - positions[legs][:, robot]
-    distances, fractions = segment_minimum(start, velocity)
-    return _best(distances, fractions, legs, robot, obstacle)
+    if r:
+        a, b = a[a.size - k * r:], b[b.size - k * r:]
+        distance, leg, pair, fraction = _pairs_minimum(points, legs, a, b)
+        best = (distance, leg, int(a[pair]), int(b[pair]), fraction)
+    found = _pruned_robot_minimum(positions, legs, _breakpoint_bound(positions, obstacles))
+    return min(best, found, key=lambda item: item[0])
 
 
 def certify(times, positions, obstacles):
     """Return the Clearance of the motion through breakpoints (times (V,), positions (V, k, d)).
 
     Exact (closed form per leg) over every robot pair and every robot-obstacle
-    pair; legs where nothing moves are covered by their neighbours' end points.
+    pair; the pruning for many robots drops only pairs that cannot be closest.
     """
-    legs = _moving_legs(positions)
-    candidates = []
-    if positions.shape[1] > 1:
-        distance, leg, a, b, fraction = robot_pair_minimum(positions, legs)
-        candidates.append((distance, 'robots', (a, b), leg, fraction))
-    if len(obstacles) and positions.shape[1]:
-        distance, leg, a, b, fraction = obstacle_minimum(positions, legs, obstacles)
-        candidates.append((distance, 'obstacle', (a, b), leg, fraction))
-    if not candidates:
+    k, r = positions.shape[1], len(obstacles)
+    if k == 0 or (k == 1 and r == 0):
         return Clearance(np.inf, 'none', (), 0, 0.0, 0.0)
-    distance, kind, indices, leg, fraction = min(candidates, key=lambda item: item[0])
-    next_leg = min(leg + 1, times.size - 1)
-    tau = float(times[leg] + fraction * (times[next_leg] - times[leg]))
-    return Clearance(distance, kind, indices, leg, fraction, tau)
+    distance, leg, first, second, fraction = _closest(positions, obstacles)
+    tau = float(times[leg] + fraction * (times[leg + 1] - times[leg]))
+    if second >= k:
+        return Clearance(distance, 'obstacle', (first, second - k), leg, fraction, tau)
+    return Clearance(distance, 'robots', (first, second), leg, fraction, tau)

@@ -19,7 +19,7 @@ from .deformations import desingularize, desingularizing_shift, spread
 from .errors import ErrorCode, PlanningError
 from .sections import (compose, lane_heights, PAPER_FRACTIONS, PAPER_LEGS, segment_times,
                        SPREAD_FRACTIONS, SPREAD_LEGS)
-from .strata import epsilon, projection_count
+from .strata import epsilon, projection_count, projection_gaps
 from .timing import breakpoint_stamps, resample
 from .validation import validate_configurations
 
@@ -102,7 +102,8 @@ class Plan:
         with np.errstate(divide='ignore', invalid='ignore'):
             fraction = np.where(end > start, (tau - start) / (end - start), 0.0)
         fraction = np.clip(fraction, 0.0, 1.0)[..., None, None]
-        return self.positions[leg] + fraction * (self.positions[leg + 1] - self.positions[leg])
+        # (1 - f) a + f b, not a + f (b - a): exact at both ends of every leg.
+        return (1.0 - fraction) * self.positions[leg] + fraction * self.positions[leg + 1]
 
     def stamps(self, max_speed):
         """Return (V,) seconds from the start at each breakpoint, fastest robot at max_speed."""
@@ -132,8 +133,9 @@ def plan(workspace, configurations, certify=True):
     r = workspace.obstacle_count
     frame = workspace.frame
     projections = frame.project(configurations)
-    counts = projection_count(projections, workspace.obstacle_projections)
-    eps = epsilon(projections, workspace.obstacle_projections, workspace.lane_spacing)
+    gaps = projection_gaps(projections, workspace.obstacle_projections)
+    counts = projection_count(gaps)
+    eps = epsilon(gaps, workspace.lane_spacing)
     shift = desingularizing_shift(counts, eps, k, r)
     desingularized = desingularize(configurations, shift, frame.e1)
     projections = projections + shift

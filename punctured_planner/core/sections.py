@@ -6,6 +6,8 @@ n-th sequential section concatenates Gamma(L_m, L_{m+1}) and, by Remark 2.3,
 wraps each segment in the deformations H(C_m) forward and H(C_{m+1}) backward.
 """
 
+from functools import lru_cache
+
 import numpy as np
 
 # Breakpoint fractions of one segment [tau_m, tau_{m+1}]: the first third is
@@ -31,6 +33,7 @@ def lane_heights(robot_count, obstacle_count, lane_spacing, lane_base, variant):
     return lane_base + (first + np.arange(robot_count)) * lane_spacing
 
 
+@lru_cache(maxsize=64)
 def segment_times(configuration_count, fractions):
     """Return breakpoint parameters: tau_m + (tau_{m+1} - tau_m) f for each segment.
 
@@ -39,7 +42,9 @@ def segment_times(configuration_count, fractions):
     """
     tau = np.arange(configuration_count) / (configuration_count - 1)
     times = tau[:-1, None] + np.diff(tau)[:, None] * np.asarray(fractions)[None, :]
-    return np.concatenate([times[:, :-1].ravel(), tau[-1:]])
+    times = np.concatenate([times[:, :-1].ravel(), tau[-1:]])
+    times.flags.writeable = False
+    return times
 
 
 def compose(deformation_stages, lanes, e2):
@@ -50,12 +55,16 @@ def compose(deformation_stages, lanes, e2):
     runs H(C_m) forward, Gamma(L_m, L_{m+1}), then H(C_{m+1}) backward.
     """
     axis = deformation_stages[-1]
-    lifted = axis + lanes[None, :, None] * e2
+    lifted = axis + lanes[:, None] * e2
     forward = deformation_stages
     backward = deformation_stages[::-1]
     segment = ([stage[:-1] for stage in forward]
                + [lifted[:-1], lifted[1:]]
                + [stage[1:] for stage in backward[:-1]])
-    stacked = np.stack(segment, axis=1)
     n, k, d = deformation_stages[0].shape
-    return np.concatenate([stacked.reshape(-1, k, d), deformation_stages[0][-1:]])
+    positions = np.empty(((n - 1) * len(segment) + 1, k, d))
+    by_segment = positions[:-1].reshape(n - 1, len(segment), k, d)
+    for leg, stage in enumerate(segment):
+        by_segment[:, leg] = stage
+    positions[-1] = deformation_stages[0][-1]
+    return positions

@@ -9,27 +9,33 @@ import numpy as np
 
 def all_projections(robot_projections, obstacle_projections):
     """Return (n, r + k) projections in the paper's numbering: obstacles first, then robots."""
-    n = robot_projections.shape[0]
-    obstacles = np.broadcast_to(obstacle_projections, (n, obstacle_projections.size))
-    return np.concatenate([obstacles, robot_projections], axis=1)
+    n, k = robot_projections.shape
+    r = obstacle_projections.size
+    points = np.empty((n, r + k))
+    points[:, :r] = obstacle_projections
+    points[:, r:] = robot_projections
+    return points
 
 
-def projection_count(robot_projections, obstacle_projections):
+def projection_gaps(robot_projections, obstacle_projections):
+    """Return the (n, k + r - 1) gaps between consecutive sorted projections of each C_m."""
+    ordered = np.sort(all_projections(robot_projections, obstacle_projections), axis=1)
+    return ordered[:, 1:] - ordered[:, :-1]
+
+
+def projection_count(gaps):
     """Return cp(C_m) for each configuration: distinct projections among all k + r points.
 
-    robot_projections is (n, k), obstacle_projections (r,); the result is (n,) ints.
+    gaps are the (n, k + r - 1) sorted projection gaps; the result is (n,) ints.
     """
-    gaps = np.diff(np.sort(all_projections(robot_projections, obstacle_projections)), axis=1)
     return 1 + np.count_nonzero(gaps > 0, axis=1)
 
 
-def epsilon(robot_projections, obstacle_projections, fallback):
+def epsilon(gaps, fallback):
     """Return eps(C_m) = min{|p(a) - p(b)| : p(a) != p(b)} / (k + r) for each configuration.
 
     When every projection coincides (only possible for r <= 1) the set is empty;
     `fallback` / (k + r), a constant, keeps D continuous on that stratum.
     """
-    points = all_projections(robot_projections, obstacle_projections)
-    gaps = np.diff(np.sort(points), axis=1)
     smallest = np.where(gaps > 0, gaps, np.inf).min(axis=1, initial=np.inf)
-    return np.where(np.isfinite(smallest), smallest, fallback) / points.shape[1]
+    return np.where(np.isfinite(smallest), smallest, fallback) / (gaps.shape[1] + 1)

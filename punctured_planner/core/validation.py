@@ -9,14 +9,21 @@ obstacle at fault.
 import numpy as np
 
 from .errors import ErrorCode, PlanningError
+from .pairs import pair_difference_matrix, point_pairs
+
+# Up to this many robots, coincidences are found by comparing every pair.
+_PAIRWISE_ROBOTS = 32
 
 
 def _as_array(configurations, dimension):
     """Return configurations as a float (n, k, d) array or raise a shape error."""
-    if isinstance(configurations, np.ndarray):
-        items = list(configurations) if configurations.ndim >= 1 else [configurations]
-    else:
-        items = list(configurations)
+    if isinstance(configurations, np.ndarray) and configurations.ndim == 3:
+        if configurations.shape[0] < 2:
+            raise PlanningError(ErrorCode.NO_CONFIGURATIONS,
+                                f'need at least 2 configurations, got {configurations.shape[0]}')
+        if configurations.shape[2] == dimension and configurations.shape[1] > 0:
+            return configurations.astype(float)
+    items = list(configurations)
     if len(items) < 2:
         raise PlanningError(ErrorCode.NO_CONFIGURATIONS,
                             f'need at least 2 configurations, got {len(items)}')
@@ -38,8 +45,8 @@ def _as_array(configurations, dimension):
     return np.stack(arrays)
 
 
-def _coincident_robots(configurations):
-    """Return (m, a, b) for two robots at the same point in C_m, or None."""
+def _sorted_coincidence(configurations):
+    """Return (m, a, b) for two robots at one point in C_m, sorting the points; or None."""
     n, k, d = configurations.shape
     flat = configurations.reshape(n * k, d)
     config = np.repeat(np.arange(n), k)
@@ -54,27 +61,56 @@ def _coincident_robots(configurations):
     return int(first // k), a, b
 
 
+def _coincidences(configurations, obstacles):
+    """Return ((m, a, b) robots at one point or None, (m, robot, obstacle) or None).
+
+    Few robots: one product with the pair difference matrix gives every
+    robot-robot and robot-obstacle difference; many: sort, and compare each
+    robot with each obstacle.
+    """
+    n, k, d = configurations.shape
+    r = len(obstacles)
+    if k <= _PAIRWISE_ROBOTS:
+        points = np.concatenate([configurations, np.broadcast_to(obstacles, (n, r, d))], axis=1)
+        zero = ~(pair_difference_matrix(k, r) @ points).any(axis=2)
+        if not zero.any():
+            return None, None
+        a, b = point_pairs(k, r)
+        robot_pairs = k * (k - 1) // 2
+        hits = np.argwhere(zero[:, :robot_pairs])
+        robots = (int(hits[0][0]), int(a[hits[0][1]]), int(b[hits[0][1]])) if hits.size else None
+        hits = np.argwhere(zero[:, robot_pairs:])
+        on = None
+        if hits.size:
+            m, pair = int(hits[0][0]), robot_pairs + int(hits[0][1])
+            on = (m, int(a[pair]), int(b[pair]) - k)
+        return robots, on
+    on = None
+    if r:
+        hits = np.argwhere(np.all(configurations[:, :, None, :] == obstacles[None, None], axis=3))
+        on = tuple(int(v) for v in hits[0]) if hits.size else None
+    return _sorted_coincidence(configurations), on
+
+
 def validate_configurations(configurations, obstacles):
     """Return the request as a float (n, k, d) array after every check, or raise PlanningError."""
     configurations = _as_array(configurations, obstacles.shape[1])
-    bad = np.argwhere(~np.isfinite(configurations))
-    if bad.size:
-        m, robot, axis = (int(v) for v in bad[0])
+    finite = np.isfinite(configurations)
+    if not finite.all():
+        m, robot, axis = (int(v) for v in np.argwhere(~finite)[0])
         raise PlanningError(ErrorCode.NON_FINITE_VALUE,
                             f'configuration {m}, robot {robot}: coordinate {axis} is '
                             f'{configurations[m, robot, axis]}', configuration=m, robots=[robot])
-    coincident = _coincident_robots(configurations)
+    coincident, on_obstacle = _coincidences(configurations, obstacles)
     if coincident is not None:
         m, a, b = coincident
         raise PlanningError(ErrorCode.ROBOTS_COINCIDE,
                             f'configuration {m}: robots {a} and {b} are at the same point '
                             f'{configurations[m, a].tolist()}', configuration=m, robots=[a, b])
-    if len(obstacles):
-        on = np.argwhere(np.all(configurations[:, :, None, :] == obstacles[None, None], axis=3))
-        if on.size:
-            m, robot, obstacle = (int(v) for v in on[0])
-            raise PlanningError(ErrorCode.ROBOT_ON_OBSTACLE,
-                                f'configuration {m}: robot {robot} is on obstacle {obstacle} '
-                                f'at {obstacles[obstacle].tolist()}', configuration=m,
-                                robots=[robot], obstacle=obstacle)
+    if on_obstacle is not None:
+        m, robot, obstacle = on_obstacle
+        raise PlanningError(ErrorCode.ROBOT_ON_OBSTACLE,
+                            f'configuration {m}: robot {robot} is on obstacle {obstacle} '
+                            f'at {obstacles[obstacle].tolist()}', configuration=m,
+                            robots=[robot], obstacle=obstacle)
     return configurations

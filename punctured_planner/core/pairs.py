@@ -1,0 +1,36 @@
+"""Index arrays of point pairs, built once per size (they sit on every hot path)."""
+
+from functools import lru_cache
+
+import numpy as np
+
+
+@lru_cache(maxsize=32)
+def point_pairs(robot_count, obstacle_count=0):
+    """Return read-only index arrays (a, b) into the k + r points of a configuration.
+
+    First every robot pair a < b, then every (robot, obstacle) pair with the
+    obstacle numbered k + its index.
+    """
+    a, b = np.triu_indices(robot_count, 1)
+    robot = np.repeat(np.arange(robot_count), obstacle_count)
+    obstacle = robot_count + np.tile(np.arange(obstacle_count), robot_count)
+    first, second = np.concatenate([a, robot]), np.concatenate([b, obstacle])
+    first.flags.writeable = second.flags.writeable = False
+    return first, second
+
+
+@lru_cache(maxsize=32)
+def pair_difference_matrix(robot_count, obstacle_count=0):
+    """Return the (pairs, k + r) matrix with rows e_a - e_b for the pairs of point_pairs.
+
+    Every row has one +1 and one -1, so each product is a single exact
+    subtraction: M @ points gives every pair's relative position at once,
+    faster than two fancy-index gathers for a few dozen points.
+    """
+    a, b = point_pairs(robot_count, obstacle_count)
+    matrix = np.zeros((a.size, robot_count + obstacle_count))
+    matrix[np.arange(a.size), a] = 1.0
+    matrix[np.arange(a.size), b] = -1.0
+    matrix.flags.writeable = False
+    return matrix
