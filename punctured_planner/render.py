@@ -1,0 +1,108 @@
+"""
+Pictures of plans from the command line, and the glue for ``punctured-planner plan``.
+
+``python -m punctured_planner.render domain OUT.png [--robots 1|2]`` draws the
+domain picture; ``python -m punctured_planner.render example --png OUT.png
+--gif OUT.gif`` draws the example plan (the README pictures). The ``plan``
+command of ``punctured-planner`` gets ``--png``/``--gif`` with two lines::
+
+    add_render_arguments(plan_parser)      # when building the parser
+    render_outputs(args, the_plan)         # once the plan is made
+"""
+
+import argparse
+import sys
+
+from .viz import domain_picture, example_plan, render_animation, render_png
+
+
+def _positive_float(text):
+    """Return text as a float > 0, or raise argparse.ArgumentTypeError."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'{text!r} is not a number')
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f'{text!r} is not positive')
+    return value
+
+
+def _gif_path(text):
+    """Return text if it names a .gif file, or raise argparse.ArgumentTypeError."""
+    if not text.lower().endswith('.gif'):
+        raise argparse.ArgumentTypeError(f'{text!r}: the animation is written as a .gif file')
+    return text
+
+
+def add_render_arguments(parser):
+    """Add --png, --dpi, --gif, --gif-fps, --gif-seconds and --gif-dpi to an argparse parser."""
+    group = parser.add_argument_group('pictures')
+    group.add_argument('--png', metavar='OUT.png',
+                       help='draw the plan (paths, lanes, waypoints, domain, clearance)')
+    group.add_argument('--gif', metavar='OUT.gif', type=_gif_path,
+                       help='animate the synchronous motion of all robots')
+    group.add_argument('--gif-fps', type=_positive_float, default=20.0,
+                       help='frames per second of the animation (default: %(default)s)')
+    group.add_argument('--gif-seconds', type=_positive_float, default=8.0,
+                       help='length of the animation in seconds (default: %(default)s)')
+    group.add_argument('--gif-dpi', type=_positive_float, default=80.0,
+                       help='resolution of the animation (default: %(default)s)')
+    group.add_argument('--dpi', type=_positive_float, default=100.0,
+                       help='resolution of the PNG picture (default: %(default)s)')
+    return group
+
+
+def render_outputs(args, plan, title=None):
+    """Write the pictures asked for by add_render_arguments' options; return their paths."""
+    written = []
+    if getattr(args, 'png', None):
+        written.append(render_png(plan, args.png, title=title, dpi=args.dpi))
+    if getattr(args, 'gif', None):
+        written.append(render_animation(plan, args.gif, fps=args.gif_fps,
+                                        seconds=args.gif_seconds, dpi=args.gif_dpi,
+                                        title=title))
+    return written
+
+
+def _domain(args):
+    """Draw the domain picture."""
+    print(domain_picture(args.output, robot_count=args.robots, dpi=args.dpi))
+    return 0
+
+
+def _example(args):
+    """Draw the example plan."""
+    paths = render_outputs(args, example_plan(args.variant), title='example scenario')
+    for path in paths:
+        print(path)
+    return 0 if paths else 2
+
+
+def make_parser():
+    """Return the parser of ``python -m punctured_planner.render``."""
+    parser = argparse.ArgumentParser(prog='python -m punctured_planner.render',
+                                     description='Draw pictures of the planner.')
+    commands = parser.add_subparsers(dest='command', required=True)
+    domain = commands.add_parser('domain', help='the domain picture (PNG)')
+    domain.add_argument('output', metavar='OUT.png')
+    domain.add_argument('--robots', type=int, choices=(1, 2), default=1,
+                        help='number of robots (default: %(default)s)')
+    domain.add_argument('--dpi', type=_positive_float, default=100.0,
+                        help='resolution (default: %(default)s)')
+    domain.set_defaults(func=_domain)
+    example = commands.add_parser('example', help='the example plan (PNG and/or GIF)')
+    add_render_arguments(example)
+    example.add_argument('--variant', choices=('paper', 'spread'), default='spread',
+                         help='planner variant (default: %(default)s)')
+    example.set_defaults(func=_example)
+    return parser
+
+
+def main(argv=None):
+    """Run ``python -m punctured_planner.render``; return the exit status."""
+    args = make_parser().parse_args(argv)
+    return args.func(args)
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,155 @@
+"""
+render_animation: the synchronous motion as an animated GIF, all robots moving together.
+
+Frames follow the time parameterisation of the plan (each leg lasts as long as
+its fastest robot needs at max_speed), every breakpoint position is a frame and
+each robot leaves a trail, so a viewer sees the robots switch legs together and
+never meet.
+"""
+
+import os
+
+from matplotlib.lines import Line2D
+import numpy as np
+from PIL import Image
+
+from .canvas import robot_colours
+from .geometry import plane_view
+from .picture import plan_figure, plan_title
+
+
+def _allocate(durations, budget):
+    """Split budget frames over legs in proportion to their durations (largest remainder)."""
+    quotas = durations / durations.sum() * budget
+    counts = np.floor(quotas).astype(int)
+    remainder = budget - counts.sum()
+    counts[np.argsort(counts - quotas)[:remainder]] += 1
+    return counts
+
+
+def frame_parameters(plan, frame_count, max_speed=1.0):
+    """
+    Return (tau (F,), seconds (F,)) of the frames: time-uniform, every breakpoint kept.
+
+    Legs where nothing moves add no frame (their end looks like their start);
+    every other breakpoint parameter is a frame, and about frame_count frames
+    in all are spread over the legs in proportion to their durations.
+    """
+    stamps = plan.stamps(max_speed)
+    durations = np.diff(stamps)
+    moving = durations > 0
+    if not moving.any():
+        return plan.times[:1].copy(), stamps[:1].copy()
+    budget = max(frame_count - 1 - int(moving.sum()), 0)
+    interior = np.zeros(durations.size, dtype=int)
+    interior[moving] = _allocate(durations[moving], budget)
+    taus = [plan.times[:1]]
+    for leg in np.flatnonzero(moving):
+        fractions = np.arange(1, interior[leg] + 2) / (interior[leg] + 1)
+        start, end = plan.times[leg], plan.times[leg + 1]
+        taus.append(start + (end - start) * fractions)
+    tau = np.concatenate(taus)
+    tau[-1] = plan.times[-1]
+    return tau, np.interp(tau, plan.times, stamps)
+
+
+def _leg_label(plan, tau):
+    """Return 'C_m -> C_m+1: <leg name>' for the leg that contains tau."""
+    legs = len(plan.leg_names)
+    leg = int(np.clip(np.searchsorted(plan.times, tau, side='right') - 1, 0, legs - 1))
+    segment = leg // (legs // (plan.configurations.shape[0] - 1))
+    return f'C_{segment + 1} -> C_{segment + 2}: {plan.leg_names[leg]}'
+
+
+class _Movers:
+    """The artists that move: one trail and one marker per robot, in one 2-D or 3-D axes."""
+
+    def __init__(self, ax, colours, three_d):
+        """Create empty trails and robot markers on ax."""
+        self.three_d = three_d
+        self.trails, self.robots = [], []
+        for colour in colours:
+            if three_d:
+                trail, = ax.plot([], [], [], color=colour, lw=2.6)
+                robot, = ax.plot([], [], [], 'o', color=colour, ms=9, mec='black', mew=0.8)
+            else:
+                trail = ax.add_line(Line2D([], [], color=colour, lw=2.6, zorder=8))
+                robot = ax.add_line(Line2D([], [], ls='none', marker='o', color=colour, ms=10,
+                                           mec='black', mew=0.8, zorder=9))
+            self.trails.append(trail)
+            self.robots.append(robot)
+
+    def update(self, history):
+        """Show the robots at history[-1] and their trails over history (F, k, 2 or 3)."""
+        for robot, (trail, marker) in enumerate(zip(self.trails, self.robots)):
+            points = history[:, robot]
+            if self.three_d:
+                trail.set_data_3d(*points.T)
+                marker.set_data_3d(*points[-1:].T)
+            else:
+                trail.set_data(*points.T)
+                marker.set_data(*points[-1:].T)
+
+
+def _palette_of(image, colours=96):
+    """Return a palette image with the colours of image: one palette for every frame."""
+    return image.convert('RGB').quantize(colors=colours, method=Image.Quantize.MEDIANCUT)
+
+
+def _grab(figure):
+    """Return the canvas as it is now, as an RGB Pillow image."""
+    return Image.fromarray(np.asarray(figure.canvas.buffer_rgba())[..., :3].copy())
+
+
+def render_animation(plan, path, fps=20, seconds=8.0, dpi=80, title=None, max_speed=1.0):
+    """
+    Write the motion as an animated GIF at path (about fps * seconds frames); return path.
+
+    The static picture is drawn once; each frame redraws only the trails, the
+    robots and the title over it (blitting), then Pillow, matplotlib's own GIF
+    writer, encodes the frames with one shared palette.
+    """
+    if os.path.splitext(str(path))[1].lower() != '.gif':
+        raise ValueError(f'render_animation writes GIF files; {path!r} does not end in .gif')
+    if not (fps > 0 and seconds > 0):
+        raise ValueError('fps and seconds must be positive')
+    tau, stamps = frame_parameters(plan, max(2, int(round(fps * seconds))), max_speed)
+    positions = plan.position(tau)
+    colours = robot_colours(positions.shape[1])
+    figure, axes = plan_figure(plan, dpi=dpi, title=title, path_alpha=0.25, arrows=False)
+    heading = plan_title(plan, title)
+
+    def caption(frame):
+        """Return the title of one frame: the plan's title, the time and the leg."""
+        return (f'{heading}\nt = {stamps[frame]:.2f} s at {max_speed:g} m/s '
+                f'(tau {tau[frame]:.3f}), {_leg_label(plan, tau[frame])}')
+
+    heading_text = figure.suptitle(caption(0), fontsize=10)
+    movers = []
+    if len(axes) == 2:
+        movers.append((_Movers(axes[0], colours, True), positions))
+    movers.append((_Movers(axes[-1], colours, False), plane_view(plan)(positions)))
+    dynamic = [heading_text] + [artist for mover, _ in movers
+                                for artist in mover.trails + mover.robots]
+    figure.canvas.draw()
+    figure.set_layout_engine('none')
+    for artist in dynamic:
+        artist.set_visible(False)
+    figure.canvas.draw()
+    background = figure.canvas.copy_from_bbox(figure.bbox)
+    for artist in dynamic:
+        artist.set_visible(True)
+    frames = []
+    for frame in range(tau.size):
+        figure.canvas.restore_region(background)
+        for mover, points in movers:
+            mover.update(points[:frame + 1])
+        heading_text.set_text(caption(frame))
+        for artist in dynamic:
+            figure.draw_artist(artist)
+        frames.append(_grab(figure))
+    palette = _palette_of(frames[0])
+    frames = [image.quantize(palette=palette, dither=Image.Dither.NONE) for image in frames]
+    frames[0].save(path, format='GIF', save_all=True, append_images=frames[1:],
+                   duration=int(round(1000 / fps)), loop=0)
+    return path

@@ -1,0 +1,104 @@
+"""
+Draw a plan on 2-D axes through a PlaneView: the static picture and the animation background.
+
+Layers, bottom to top: e1 axis, dashed lanes, robot paths with direction
+arrows, obstacles, numbered waypoints C_1..C_n, the certified closest approach.
+"""
+
+from matplotlib.lines import Line2D
+from matplotlib.patches import FancyArrowPatch
+import numpy as np
+
+from .geometry import (axis_segment, closest_approach, extent, lane_segments, moving_legs,
+                       waypoints)
+
+AXIS_COLOUR = '0.35'
+CLEARANCE_COLOUR = 'crimson'
+ARROW_MIN_FRACTION = 0.03
+
+
+def draw_frame_lines(ax, plan, view, colours):
+    """Draw the e1 axis (solid grey) and each robot's lane (dashed, in the robot's colour)."""
+    axis = view(axis_segment(plan))
+    ax.plot(axis[:, 0], axis[:, 1], color=AXIS_COLOUR, lw=1.2, zorder=1)
+    for lane, colour in zip(view(lane_segments(plan)), colours):
+        ax.plot(lane[:, 0], lane[:, 1], ls='--', lw=0.8, color=colour, alpha=0.55, zorder=1)
+
+
+def draw_paths(ax, plan, view, colours, alpha=1.0, arrows=True):
+    """Draw each robot's polyline through the breakpoints, with an arrow on every long leg."""
+    paths = view(plan.positions)
+    minimum = ARROW_MIN_FRACTION * extent(paths)
+    for robot, colour in enumerate(colours):
+        path = paths[:, robot]
+        ax.plot(path[:, 0], path[:, 1], color=colour, lw=1.8, alpha=alpha, zorder=2,
+                solid_capstyle='round')
+        if not arrows:
+            continue
+        for start, end in zip(*moving_legs(path, minimum)):
+            step = end - start
+            ax.add_patch(FancyArrowPatch(start + 0.42 * step, start + 0.58 * step,
+                                         arrowstyle='-|>', mutation_scale=12, color=colour,
+                                         lw=0, shrinkA=0, shrinkB=0, zorder=3))
+
+
+def draw_obstacles(ax, plan, view, size=70):
+    """Draw the obstacles as black crosses."""
+    obstacles = view(plan.workspace.obstacles)
+    ax.scatter(obstacles[:, 0], obstacles[:, 1], marker='X', s=size, color='black', zorder=4)
+
+
+def draw_waypoints(ax, plan, view, colours, size=12):
+    """Draw C_1..C_n as circles in each robot's colour, numbered 1..n."""
+    for m, configuration in enumerate(view(waypoints(plan))):
+        for (x, y), colour in zip(configuration, colours):
+            ax.plot(x, y, 'o', ms=size, mfc='white', mec=colour, mew=1.6, zorder=5)
+            ax.text(x, y, str(m + 1), ha='center', va='center', fontsize=0.6 * size,
+                    color=colour, fontweight='bold', zorder=6)
+
+
+def draw_closest_approach(ax, plan, view):
+    """Draw the certified closest approach as a dotted crimson segment."""
+    points = closest_approach(plan)
+    if points is None:
+        return
+    points = view(points)
+    ax.plot(points[:, 0], points[:, 1], ':', color=CLEARANCE_COLOUR, lw=1.6, zorder=7)
+    ax.plot(points[:, 0], points[:, 1], 'o', color=CLEARANCE_COLOUR, ms=3.5, zorder=7)
+
+
+def legend_handles(plan, colours, waypoints_numbered=True):
+    """Return proxy artists naming the robots and every layer of the picture."""
+    handles = [Line2D([], [], color=colour, lw=2, label=f'robot {robot}')
+               for robot, colour in enumerate(colours)]
+    handles += [
+        Line2D([], [], ls='none', marker='X', ms=8, color='black', label='obstacle'),
+        Line2D([], [], color=AXIS_COLOUR, lw=1.2, label='e1 axis'),
+        Line2D([], [], color='0.5', ls='--', lw=0.8, label='lanes'),
+    ]
+    if waypoints_numbered:
+        handles.append(Line2D([], [], ls='none', marker='o', ms=9, mfc='white', mec='0.3',
+                              label='C_m (numbered m)'))
+    if closest_approach(plan) is not None:
+        handles.append(Line2D([], [], ls=':', color=CLEARANCE_COLOUR, lw=1.6,
+                              label=f'closest: {plan.min_clearance:.3g}'))
+    return handles
+
+
+def draw_plan_2d(ax, plan, view, colours, path_alpha=1.0, arrows=True):
+    """Draw every layer of the plan on ax and label the axes by the view."""
+    draw_frame_lines(ax, plan, view, colours)
+    draw_paths(ax, plan, view, colours, alpha=path_alpha, arrows=arrows)
+    draw_obstacles(ax, plan, view)
+    draw_waypoints(ax, plan, view, colours)
+    draw_closest_approach(ax, plan, view)
+    ax.set_xlabel(view.labels[0])
+    ax.set_ylabel(view.labels[1])
+    ax.set_aspect('equal', adjustable='box')
+    ax.grid(True, lw=0.4, alpha=0.4)
+    points = np.concatenate([view(plan.positions).reshape(-1, 2),
+                             view(plan.workspace.obstacles).reshape(-1, 2)])
+    low, high = points.min(axis=0), points.max(axis=0)
+    pad = 0.06 * max(float((high - low).max()), 1.0)
+    ax.set_xlim(low[0] - pad, high[0] + pad)
+    ax.set_ylim(low[1] - pad, high[1] + pad)

@@ -1,0 +1,24 @@
+"""
+The example scenario of the pictures: 5 robots, 3 obstacles off one line, n = 3, spread.
+
+The robots start in a row below the obstacles, meet in a ring around them
+(one robot right above an obstacle, so C_2 lies in a lower stratum and D
+moves) and end in a row above, in reverse order.
+"""
+
+import numpy as np
+
+from ..core import plan, Workspace
+
+EXAMPLE_OBSTACLES = [[-3.0, 0.5], [0.0, -0.5], [2.5, 0.0]]
+EXAMPLE_CONFIGURATIONS = [
+    [[-4.0, -2.0], [-2.0, -2.5], [0.0, -2.0], [2.0, -2.5], [4.0, -2.0]],
+    [[0.0, 2.5], [-2.4, 0.8], [-1.5, -2.0], [1.5, -2.0], [2.4, 0.8]],
+    [[4.0, 3.0], [2.0, 3.5], [0.0, 3.0], [-2.0, 3.5], [-4.0, 3.0]],
+]
+
+
+def example_plan(variant='spread'):
+    """Return the plan of the example scenario (variant 'spread' unless told otherwise)."""
+    workspace = Workspace(EXAMPLE_OBSTACLES, variant=variant)
+    return plan(workspace, np.array(EXAMPLE_CONFIGURATIONS))
