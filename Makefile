@@ -40,18 +40,19 @@ STAMP_IFACE := $(STAMPS)/interfaces-$(IFACE_KEY)-$(WHEELS_KEY)
 STAMP_PROJECT := $(STAMPS)/project-$(PROJECT_KEY)-$(IFACE_KEY)-$(WHEELS_KEY)
 
 # Missing prerequisites stop the build with one line saying what to install.
-ifneq ($(filter setup test run lock,$(MAKECMDGOALS)),)
-ifeq ($(wildcard $(VPY))$(filter lock,$(MAKECMDGOALS)),)
+SETUP_GOALS := $(filter setup test run,$(MAKECMDGOALS))
+ifneq ($(filter lock,$(MAKECMDGOALS))$(if $(SETUP_GOALS),$(if $(wildcard $(VPY)),,x)),)
 ifeq ($(shell command -v $(PYTHON)),)
 $(error $(PYTHON) not found: install Python 3.11 (Debian 12: apt-get install python3.11 python3.11-venv))
 endif
-ifneq ($(shell $(PYTHON) -c 'import sys; print(sys.version_info[:2] == (3, 11))'),True)
+ifneq ($(shell $(PYTHON) -c 'import sys; print(sys.version_info[:2] == (3, 11))' 2>/dev/null),True)
 $(error $(PYTHON) is not Python 3.11, which the ros-jazzy wheels need: install python3.11 or set PYTHON=/path/to/python3.11)
 endif
 ifneq ($(shell $(PYTHON) -c 'import ensurepip, venv' >/dev/null 2>&1 && echo ok),ok)
 $(error $(PYTHON) cannot create virtual environments: install python3.11-venv (apt-get install python3.11-venv))
 endif
 endif
+ifneq ($(SETUP_GOALS),)
 ifeq ($(wildcard $(STAMP_IFACE)),)
 ifeq ($(shell command -v cmake),)
 $(error cmake not found: install cmake (apt-get install cmake))

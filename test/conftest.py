@@ -200,7 +200,7 @@ def planner_process(ros_env, tmp_path):
     ``start(*ros_args, params_file=None, namespace=None, env=None)`` launches
     ``.venv/bin/planner_node --ros-args -r __ns:=<namespace> [--params-file F]
     [ros_args...]`` with the whole environment (plus ``env`` overrides). The
-    namespace defaults to a fresh ``/pp_test_<n>`` so a test never reaches another
+    namespace defaults to a fresh ``/pp_test_<pid>_<n>`` so a test never reaches another
     test's node; use ``proc.name('plan_sequence')`` for the service name. Every
     process is stopped (SIGINT, then kill) after the test.
     """
@@ -208,7 +208,7 @@ def planner_process(ros_env, tmp_path):
 
     def start(*ros_args, params_file=None, namespace=None, env=None):
         if namespace is None:
-            namespace = '/pp_test_%d' % next(_namespace_counter)
+            namespace = '/pp_test_%d_%d' % (os.getpid(), next(_namespace_counter))
         args = [venv_script('planner_node'), '--ros-args', '-r', '__ns:=' + namespace]
         if params_file is not None:
             args += ['--params-file', str(params_file)]

@@ -12,6 +12,7 @@ import sys
 from conftest import REPO_ROOT
 from conftest import venv_script
 import pytest
+import yaml
 
 EXPECTED_CONSTANTS = {
     'NONE': 0,
@@ -150,7 +151,6 @@ def test_cli_call_against_node(planner_process, ros_env, tmp_path):
          '--service', node.name('plan_sequence'), '--wait', '20', '--no-paths'],
         env=ros_env, capture_output=True, text=True, timeout=60)
     assert 'error_code:' in result.stdout, result.stdout + result.stderr + node.log()
-    import yaml
     data = yaml.safe_load(result.stdout)
     assert data['error_code'] in EXPECTED_CONSTANTS.values()
     assert result.returncode == (0 if data['error_code'] == 0 else 1), result.stderr
