@@ -1,4 +1,5 @@
-"""Clearance and path length of the 'paper' and 'spread' variants side by side (issue 4).
+"""
+Clearance and path length of the 'paper' and 'spread' variants side by side (issue 4).
 
 1,000 seeded random requests whose robots are at least 0.5 apart and at least
 0.5 from every obstacle (lane_spacing 1, min_spacing 0.5): the certified

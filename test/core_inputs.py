@@ -4,7 +4,8 @@ import numpy as np
 
 
 def configuration_with_count(rng, obstacles, robot_count, target_count, frame_axis=0):
-    """Return a (k, d) configuration whose projection count cp equals target_count.
+    """
+    Return a (k, d) configuration whose projection count cp equals target_count.
 
     Obstacles must have distinct coordinates on frame_axis. target_count - r new
     projection values go to as many robots; the others share an existing value

@@ -1,12 +1,13 @@
-"""Hypothesis strategies for the core: random and degenerate requests.
+"""
+Hypothesis strategies for the core: random and degenerate requests.
 
 Coordinates come from a coarse grid so that robots share projections with
 each other and with obstacles; modes force all robots onto one vertical line,
 or every configuration into the lowest stratum (every robot above an obstacle).
 """
 
-import numpy as np
 from hypothesis import strategies as st
+import numpy as np
 
 GRID = st.integers(-8, 8).map(lambda v: v / 2)
 FLOAT = st.floats(-10, 10, allow_nan=False).map(lambda v: round(v, 6))
@@ -15,7 +16,7 @@ MODES = ('grid', 'vertical', 'lowest', 'float')
 
 @st.composite
 def requests(draw, max_robots=8, max_obstacles=5, max_configurations=5, modes=MODES):
-    """Return (obstacles (r, d), configurations (n, k, d), mode) with valid, often degenerate input."""
+    """Return (obstacles (r, d), configurations (n, k, d), mode): valid, often degenerate."""
     d = draw(st.sampled_from([2, 3, 4]))
     r = draw(st.integers(0, max_obstacles))
     k = draw(st.integers(1, max_robots))

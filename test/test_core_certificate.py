@@ -1,10 +1,9 @@
 """The clearance certificate: exact closed form, and its pruning for many robots drops nothing."""
 
 import numpy as np
-import pytest
-
 from punctured_planner.core import certificate, plan, Workspace
 from punctured_planner.core.certificate import certify, segment_minimum
+import pytest
 
 
 def test_segment_minimum_closed_form():

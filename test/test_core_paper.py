@@ -3,11 +3,10 @@
 from fractions import Fraction
 
 import numpy as np
-import pytest
-
-from punctured_planner.core import ErrorCode, PlanningError, Workspace, plan
+from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
 from punctured_planner.core.complexity import sequential_complexity
 from punctured_planner.core.sections import PAPER_FRACTIONS
+import pytest
 
 WORKED_OBSTACLES = [[0.0, 0.0], [1.0, 0.0]]
 WORKED_REQUEST = [[[0.5, 1.0], [0.5, -2.0]], [[3.0, 0.5], [-1.0, 2.0]]]
@@ -65,7 +64,7 @@ def test_robot_sharing_projection_with_obstacle_moves_off_it():
 
 
 def test_without_obstacles_and_with_one():
-    """r = 0 and r = 1: their own domain ranges and lanes."""
+    """Without obstacles and with one: their own domain ranges and lanes."""
     free = plan(Workspace([], dimension=3), np.random.default_rng(1).normal(size=(3, 4, 3)))
     assert free.domain_range == (3, 12) and free.domain_count == 10
     assert free.sequential_complexity == 10 and free.optimal

@@ -1,13 +1,12 @@
 """Properties of the core over random and degenerate inputs (hypothesis)."""
 
-import numpy as np
-from hypothesis import given, HealthCheck, settings
-from hypothesis import strategies as st
-import pytest
-
 from core_inputs import axis_obstacles, configuration_with_count
 from core_strategies import requests
+from hypothesis import given, HealthCheck, settings
+from hypothesis import strategies as st
+import numpy as np
 from punctured_planner.core import plan, Workspace
+import pytest
 
 PROPERTY = settings(max_examples=150, deadline=None,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
@@ -64,7 +63,7 @@ def test_certified_clearance_is_positive_and_agrees_with_dense_check(request, va
 @PROPERTY
 @given(requests(), VARIANTS)
 def test_domain_is_the_sum_of_projection_counts(request, variant):
-    """l = cp(C_1) + ... + cp(C_n), inside its range; index and count follow."""
+    """The domain l = cp(C_1) + ... + cp(C_n), inside its range; index and count follow."""
     obstacles, configurations, mode = request
     ws = Workspace(obstacles, dimension=obstacles.shape[1], variant=variant)
     p = plan(ws, configurations)
@@ -102,7 +101,8 @@ def perturb_within_domain(rng, configurations, obstacles, size):
         values = np.unique(configuration[:, 0])
         shifts = rng.uniform(-size, size, values.size) / 2
         shifts[np.isin(values, obstacles[:, 0])] = 0.0
-        perturbed[m, :, 0] = configuration[:, 0] + shifts[np.searchsorted(values, configuration[:, 0])]
+        group = np.searchsorted(values, configuration[:, 0])
+        perturbed[m, :, 0] = configuration[:, 0] + shifts[group]
     return perturbed
 
 

@@ -1,12 +1,11 @@
 """The 'spread' variant: same domains as the paper's, with a clearance a robot can rely on."""
 
-import numpy as np
-from hypothesis import given, HealthCheck, settings
-import pytest
-
 from core_strategies import requests
+from hypothesis import given, HealthCheck, settings
+import numpy as np
 from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
 from punctured_planner.core.deformations import spread
+import pytest
 
 PROPERTY = settings(max_examples=150, deadline=None,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])

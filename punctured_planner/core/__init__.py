@@ -1,4 +1,5 @@
-"""ROS-free math core: the sequential planner of Ipanaque Zapata & González, numpy only.
+"""
+ROS-free math core: the sequential planner of Ipanaque Zapata & González, numpy only.
 
 One module per idea of the paper: ``space`` (the space and its frame),
 ``strata`` (cp and eps), ``deformations`` (D, S, phi), ``sections`` (Gamma,

@@ -1,4 +1,5 @@
-"""Exact clearance certificate of a piecewise-linear synchronous motion.
+"""
+Exact clearance certificate of a piecewise-linear synchronous motion.
 
 Between two breakpoints every robot moves linearly, so the relative position
 of two robots (or of a robot and a fixed obstacle) is r(t) = r0 + t v on
@@ -13,6 +14,7 @@ it. A sort along the best axis (sweep and prune) finds the other pairs.
 """
 
 from dataclasses import dataclass
+
 import numpy as np
 from scipy.spatial import cKDTree
 
@@ -26,7 +28,8 @@ _CHUNK_ELEMENTS = 1 << 22
 
 @dataclass(frozen=True)
 class Clearance:
-    """The minimum distance of a motion and where it is reached.
+    """
+    The minimum distance of a motion and where it is reached.
 
     kind is 'robots' (indices = two robots) or 'obstacle' (indices = robot,
     obstacle); leg is the breakpoint interval [leg, leg + 1] and fraction the
@@ -43,7 +46,8 @@ class Clearance:
 
 
 def segment_minimum(start, velocity):
-    """Return (min squared distance, t*) of |start + t velocity| over t in [0, 1], elementwise.
+    """
+    Return (min squared distance, t*) of |start + t velocity| over t in [0, 1], elementwise.
 
     start and velocity have shape (..., d); the result has shape (...). The
     distance is taken from the closest point itself, not from |r0|^2 - <r0, v>^2
@@ -98,7 +102,8 @@ def _breakpoint_bound(positions, obstacles):
 
 
 def _sweep_pairs(start, end, bound):
-    """Return robot pairs (a, b) whose coordinate ranges over one leg come within bound.
+    """
+    Return robot pairs (a, b) whose coordinate ranges over one leg come within bound.
 
     Sorting the ranges' lower ends along the axis that leaves the fewest pairs,
     robot i is paired with the robots after it whose lower end is at most
@@ -161,7 +166,8 @@ def _closest(positions, obstacles):
 
 
 def certify(times, positions, obstacles):
-    """Return the Clearance of the motion through breakpoints (times (V,), positions (V, k, d)).
+    """
+    Return the Clearance of the motion through breakpoints (times (V,), positions (V, k, d)).
 
     Exact (closed form per leg) over every robot pair and every robot-obstacle
     pair; the pruning for many robots drops only pairs that cannot be closest.

@@ -1,4 +1,5 @@
-"""Domains of continuity and the sequential topological complexity TC_n.
+"""
+Domains of continuity and the sequential topological complexity TC_n.
 
 The paper's algorithm has domains W_l = union of A_{j_1} x ... x A_{j_n} with
 j_1 + ... + j_n = l (Section 4): l runs over n max(r, 1) .. n (k + r), that is
@@ -19,7 +20,8 @@ def domain_count(configuration_count, robot_count, obstacle_count):
 
 
 def sequential_complexity(configuration_count, robot_count, obstacle_count, dimension):
-    """Return TC_n(F(R^d - Q_r, k)), non-reduced (paper, Theorem 1.1, González–Grant).
+    """
+    Return TC_n(F(R^d - Q_r, k)), non-reduced (paper, Theorem 1.1, González–Grant).
 
     n(k-1)+1 for r = 0, d odd; n(k-1) for r = 0, d even; nk for r = 1, d even;
     nk + 1 otherwise. The theorem assumes k >= 2; for k = 1 the space is R^d

@@ -1,4 +1,5 @@
-"""The deformations that carry any configuration onto the axis: D, S and phi.
+"""
+The deformations that carry any configuration onto the axis: D, S and phi.
 
 * D, the desingularisation (paper, Section 3): robot with paper index j = r + i
   (i = 1..k) moves by t (j - 1) eps(C) e1; only for cp(C) < k + r.
@@ -31,7 +32,8 @@ def _interval_spacing(lengths, counts, min_spacing):
 
 
 def spread(projections, sorted_obstacle_projections, min_spacing):
-    """Return S(C, 1) projections: the nearest order-preserving spaced positions.
+    """
+    Return S(C, 1) projections: the nearest order-preserving spaced positions.
 
     projections (n, k) are pairwise distinct and distinct from the obstacle
     projections (they come out of D). In each interval between consecutive
@@ -68,4 +70,3 @@ def spread(projections, sorted_obstacle_projections, min_spacing):
     used = np.empty(n * k)
     used[order] = spacing
     return result.reshape(n, k), used.reshape(n, k)
-

@@ -4,7 +4,8 @@ import enum
 
 
 class ErrorCode(enum.IntEnum):
-    """Why a request cannot be planned; names and values match PlanSequence.srv.
+    """
+    Why a request cannot be planned; names and values match PlanSequence.srv.
 
     The order of the values is the priority order of the checks: a request with
     several faults reports the one with the smallest value.
@@ -27,7 +28,8 @@ class ErrorCode(enum.IntEnum):
 
 
 class PlanningError(ValueError):
-    """A request the planner refuses, with the configuration, robots and obstacle at fault.
+    """
+    A request the planner refuses, with the configuration, robots and obstacle at fault.
 
     Indices are 0-based: ``configuration`` is m for C_{m+1}, ``robots`` the robot
     indices involved, ``obstacle`` the obstacle index (or None).

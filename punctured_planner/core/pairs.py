@@ -7,7 +7,8 @@ import numpy as np
 
 @lru_cache(maxsize=32)
 def point_pairs(robot_count, obstacle_count=0):
-    """Return read-only index arrays (a, b) into the k + r points of a configuration.
+    """
+    Return read-only index arrays (a, b) into the k + r points of a configuration.
 
     First every robot pair a < b, then every (robot, obstacle) pair with the
     obstacle numbered k + its index.
@@ -22,7 +23,8 @@ def point_pairs(robot_count, obstacle_count=0):
 
 @lru_cache(maxsize=32)
 def pair_difference_matrix(robot_count, obstacle_count=0):
-    """Return the (pairs, k + r) matrix with rows e_a - e_b for the pairs of point_pairs.
+    """
+    Return the (pairs, k + r) matrix with rows e_a - e_b for the pairs of point_pairs.
 
     Every row has one +1 and one -1, so each product is a single exact
     subtraction: M @ points gives every pair's relative position at once,

@@ -1,4 +1,5 @@
-"""The plan: the sequential section sigma_{j_1..j_n} as exact breakpoints (paper, Section 4).
+"""
+The plan: the sequential section sigma_{j_1..j_n} as exact breakpoints (paper, Section 4).
 
 `plan` runs, for every configuration C_m: the projection count cp(C_m), the
 desingularisation D (only below the top stratum), the spreading leg S
@@ -76,7 +77,8 @@ class Plan:
 
     @cached_property
     def clearance_bound(self):
-        """Return a lower bound on min_clearance for the 'spread' variant (None for 'paper').
+        """
+        Return a lower bound on min_clearance for the 'spread' variant (None for 'paper').
 
         bound = min(s / (k + r) if some C_m is singular else s, g, lane_spacing):
         s is the input separation; D moves the robots of a singular C_m by less
@@ -114,7 +116,8 @@ class Plan:
         return float(self.stamps(max_speed)[-1])
 
     def sample(self, samples_per_leg, max_speed=None):
-        """Return (values, positions, is_breakpoint) with extra samples inside every leg.
+        """
+        Return (values, positions, is_breakpoint) with extra samples inside every leg.
 
         values are stamps in seconds when max_speed is given, else parameters tau.
         """
@@ -123,7 +126,8 @@ class Plan:
 
 
 def plan(workspace, configurations, certify=True):
-    """Return the Plan through configurations (n, k, d) in workspace, or raise PlanningError.
+    """
+    Return the Plan through configurations (n, k, d) in workspace, or raise PlanningError.
 
     With certify (the default) the exact clearance is computed at once and a
     plan below workspace.required_clearance is refused.

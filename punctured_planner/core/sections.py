@@ -1,4 +1,5 @@
-"""The section Gamma on axis configurations and the sequential composition (Remark 2.3).
+"""
+The section Gamma on axis configurations and the sequential composition (Remark 2.3).
 
 Gamma(L, L') (paper, equation (3.1)): robot with paper index i lifts to height
 i along e2, slides to L'_i + i e2, and drops; a third of the time each. The
@@ -21,7 +22,8 @@ SPREAD_LEGS = ('D', 'S', 'phi', 'lift', 'slide', 'drop', 'phi^-1', 'S^-1', 'D^-1
 
 
 def lane_heights(robot_count, obstacle_count, lane_spacing, lane_base, variant):
-    """Return the (k,) e2 heights of the lanes above the axis.
+    """
+    Return the (k,) e2 heights of the lanes above the axis.
 
     Paper: robot i (1-based) has paper index r + i and lane height
     (r + i) lane_spacing, exactly the paper's heights for lane_spacing 1 and
@@ -35,7 +37,8 @@ def lane_heights(robot_count, obstacle_count, lane_spacing, lane_base, variant):
 
 @lru_cache(maxsize=64)
 def segment_times(configuration_count, fractions):
-    """Return breakpoint parameters: tau_m + (tau_{m+1} - tau_m) f for each segment.
+    """
+    Return breakpoint parameters: tau_m + (tau_{m+1} - tau_m) f for each segment.
 
     Waypoints sit at tau_m = (m - 1) / (n - 1) (paper, equation (2.1)); the
     segments share their end points, so there are (n - 1) (len(f) - 1) + 1 times.
@@ -48,7 +51,8 @@ def segment_times(configuration_count, fractions):
 
 
 def compose(deformation_stages, lanes, e2):
-    """Return the (V, k, d) breakpoint positions of the sequential section.
+    """
+    Return the (V, k, d) breakpoint positions of the sequential section.
 
     deformation_stages lists (n, k, d) arrays H_0 = C, H_1, ..., H_s = L (the
     configurations after each deformation leg, ending on the axis). Segment m

@@ -1,4 +1,5 @@
-"""The punctured space R^d - Q_r and the frame (o, e1, e2) the algorithm works in.
+"""
+The punctured space R^d - Q_r and the frame (o, e1, e2) the algorithm works in.
 
 The paper normalises the obstacles onto the e1 axis and writes p(x) for the
 first coordinate (Section 3). For arbitrary obstacles we pick a frame in which
@@ -58,7 +59,8 @@ def _complement_direction(e1):
 
 
 def _moment_curve_directions(dimension, count):
-    """Return `count` deterministic unit directions (1, s, s^2, ...) on the moment curve.
+    """
+    Return `count` deterministic unit directions (1, s, s^2, ...) on the moment curve.
 
     Two distinct points share a projection on (1, s, ..., s^{d-1}) only for the at
     most d - 1 roots s of a nonzero polynomial, so among count > C(r, 2) (d - 1)
@@ -70,7 +72,8 @@ def _moment_curve_directions(dimension, count):
 
 
 def choose_frame(obstacles):
-    """Return the default frame for obstacles (r, d): deterministic, fixed per obstacle set.
+    """
+    Return the default frame for obstacles (r, d): deterministic, fixed per obstacle set.
 
     The coordinate axes (o = 0, e1 = x, e2 = y) whenever the obstacles' x
     coordinates are distinct; otherwise the next coordinate axis that works;
@@ -107,7 +110,8 @@ def _checked_frame(frame, dimension):
 
 
 class Workspace:
-    """The obstacles Q_r in R^d, the frame, and the planner's options.
+    """
+    The obstacles Q_r in R^d, the frame, and the planner's options.
 
     ``variant`` is 'paper' (the paper's construction, exact) or 'spread' (adds
     the spreading leg S and lanes `lane_spacing` apart beyond the obstacles).

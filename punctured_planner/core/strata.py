@@ -1,4 +1,5 @@
-"""The strata A_i = {C : cp(C) = i} and the desingularisation scale eps(C) (paper, Section 3).
+"""
+The strata A_i = {C : cp(C) = i} and the desingularisation scale eps(C) (paper, Section 3).
 
 All k + r points count, obstacles included: cp(C) is the number of distinct
 values of p over q_1..q_r, x_1..x_k, so r <= cp(C) <= k + r (at least 1 when r = 0).
@@ -24,7 +25,8 @@ def projection_gaps(robot_projections, obstacle_projections):
 
 
 def projection_count(gaps):
-    """Return cp(C_m) for each configuration: distinct projections among all k + r points.
+    """
+    Return cp(C_m) for each configuration: distinct projections among all k + r points.
 
     gaps are the (n, k + r - 1) sorted projection gaps; the result is (n,) ints.
     """
@@ -32,7 +34,8 @@ def projection_count(gaps):
 
 
 def epsilon(gaps, fallback):
-    """Return eps(C_m) = min{|p(a) - p(b)| : p(a) != p(b)} / (k + r) for each configuration.
+    """
+    Return eps(C_m) = min{|p(a) - p(b)| : p(a) != p(b)} / (k + r) for each configuration.
 
     When every projection coincides (only possible for r <= 1) the set is empty;
     `fallback` / (k + r), a constant, keeps D continuous on that stratum.

@@ -1,4 +1,5 @@
-"""Time parameterisation of a synchronous piecewise-linear motion (design.md section 3).
+"""
+Time parameterisation of a synchronous piecewise-linear motion (design.md section 3).
 
 Any reparameterisation common to all robots keeps the motion collision-free,
 so each leg gets the duration that lets its fastest robot move at max_speed.
@@ -23,7 +24,8 @@ def breakpoint_stamps(positions, max_speed):
 
 
 def resample(values, positions, samples_per_leg):
-    """Insert samples_per_leg evenly spaced samples inside every leg.
+    """
+    Insert samples_per_leg evenly spaced samples inside every leg.
 
     values (V,) are breakpoint parameters or stamps (both linear inside a
     leg), positions (V, k, d). Returns (values (M,), positions (M, k, d),

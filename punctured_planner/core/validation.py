@@ -1,4 +1,5 @@
-"""Input checks: a request must be a sequence of points of F(R^d - Q_r, k).
+"""
+Input checks: a request must be a sequence of points of F(R^d - Q_r, k).
 
 Checks run in the priority order of ErrorCode: shape and counts first, then
 non-finite values, then coincident robots, then robots on obstacles. Every
@@ -62,7 +63,8 @@ def _sorted_coincidence(configurations):
 
 
 def _coincidences(configurations, obstacles):
-    """Return ((m, a, b) robots at one point or None, (m, robot, obstacle) or None).
+    """
+    Return ((m, a, b) robots at one point or None, (m, robot, obstacle) or None).
 
     Few robots: one product with the pair difference matrix gives every
     robot-robot and robot-obstacle difference; many: sort, and compare each
