@@ -1,7 +1,7 @@
 """The clearance certificate: exact closed form, and its pruning for many robots drops nothing."""
 
 import numpy as np
-from punctured_planner.core import certificate, plan, Workspace
+from punctured_planner.core import certificate, ErrorCode, plan, PlanningError, Workspace
 from punctured_planner.core.certificate import certify, segment_minimum
 import pytest
 
@@ -44,3 +44,32 @@ def test_pruned_certificate_equals_all_pairs(monkeypatch, seed, spread_out):
         monkeypatch.undo()
         assert pruned.distance == direct.distance
         assert pruned.kind == direct.kind
+
+
+def test_far_from_the_origin_tiny_gaps_are_refused_not_trusted():
+    """At 1e9 a projection gap of 1e-6 is below the resolution: refused, never a silent touch."""
+    obstacles = [[1e9, 0.0], [1e9 + 10.0, 0.0]]
+    request = [[[1e9 + 1.0, 2.0], [1e9 + 1.0 + 1e-6, -3.0]], [[1e9 + 4.0, 1.0], [1e9 + 6.0, 1.0]]]
+    with pytest.raises(PlanningError) as error:
+        plan(Workspace(obstacles), request)
+    assert error.value.code == ErrorCode.CLEARANCE_BELOW_REQUIRED
+    assert 'numerical resolution' in str(error.value) and 'robots 0 and 1' in str(error.value)
+    spread_plan = plan(Workspace(obstacles, variant='spread'), request)
+    assert spread_plan.min_clearance >= 0.5 * (1 - 1e-9)
+
+
+@pytest.mark.parametrize('coordinate', [1e16, -1e300])
+def test_coordinates_beyond_the_supported_range_are_refused(coordinate):
+    """Squared distances must not overflow: coordinates beyond +-1e15 are INVALID_REQUEST."""
+    with pytest.raises(PlanningError) as error:
+        plan(Workspace([], dimension=2), [[[0.0, 0.0], [1.0, 1.0]], [[coordinate, 0.0], [2, 2]]])
+    assert error.value.code == ErrorCode.INVALID_REQUEST
+    assert 'configuration 1, robot 0' in str(error.value)
+
+
+def test_tiny_but_resolvable_coordinates_plan_and_certify():
+    """Robots 1e-9 apart near the origin, lanes scaled down: certified, positive clearance."""
+    ws = Workspace([[0.0, 0.0]], lane_spacing=1e-9, min_spacing=1e-10, variant='spread')
+    p = plan(ws, [[[1e-9, 1e-9], [2e-9, 1e-9]], [[-1e-9, -1e-9], [3e-9, 2e-9]]])
+    assert 0 < p.min_clearance <= 1e-9
+    assert p.min_clearance >= p.clearance_bound * (1 - 1e-9)

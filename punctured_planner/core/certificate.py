@@ -20,6 +20,10 @@ from scipy.spatial import cKDTree
 
 from .pairs import pair_difference_matrix, point_pairs
 
+# A clearance is trusted only above this fraction of the coordinate scale: the
+# breakpoints and the closed form each round to a few ulps of the largest
+# coordinate, so anything closer than ~1e4 ulps may be an artefact.
+RELATIVE_RESOLUTION = 1e-12
 # Up to this many robots every pair is evaluated on every leg (cheapest there).
 _DIRECT_ROBOTS = 64
 # Elements of (legs x pairs x d) arrays handled per chunk: bounds peak memory.
@@ -163,6 +167,13 @@ def _closest(positions, obstacles):
         best = (distance, leg, int(a[pair]), int(b[pair]), fraction)
     found = _pruned_robot_minimum(positions, legs, _breakpoint_bound(positions, obstacles))
     return min(best, found, key=lambda item: item[0])
+
+
+def numerical_resolution(positions, obstacles):
+    """Return the smallest clearance this motion can certify: RELATIVE_RESOLUTION x scale."""
+    scale = max(float(np.abs(positions).max(initial=0.0)),
+                float(np.abs(obstacles).max(initial=0.0)))
+    return RELATIVE_RESOLUTION * scale
 
 
 def certify(times, positions, obstacles):

@@ -14,7 +14,7 @@ from functools import cached_property
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .certificate import certify
+from .certificate import certify, numerical_resolution
 from .complexity import domain_range, sequential_complexity
 from .deformations import desingularize, desingularizing_shift, spread
 from .errors import ErrorCode, PlanningError
@@ -164,18 +164,28 @@ def plan(workspace, configurations, certify=True):
 
 
 def _check_required_clearance(result):
-    """Raise CLEARANCE_BELOW_REQUIRED if the certified clearance is below the requirement."""
+    """
+    Raise CLEARANCE_BELOW_REQUIRED if the certified clearance is not enough.
+
+    Not enough means below workspace.required_clearance, or not above the
+    numerical resolution of the coordinates (then rounding could hide a touch).
+    """
     required = result.workspace.required_clearance
+    resolution = numerical_resolution(result.positions, result.workspace.obstacles)
     clearance = result.clearance
-    if clearance.distance >= required:
+    if clearance.distance >= required and clearance.distance > resolution:
         return
+    if clearance.distance > resolution:
+        limit = f'< required {required:.6g}'
+    else:
+        limit = f'<= {resolution:.3g}, the numerical resolution of coordinates this large'
     a, b = clearance.indices
     what = (f'robots {a} and {b}' if clearance.kind == 'robots'
             else f'robot {a} and obstacle {b}')
     segment = clearance.leg // (len(result.leg_names) // (result.configurations.shape[0] - 1))
     raise PlanningError(
         ErrorCode.CLEARANCE_BELOW_REQUIRED,
-        f'{what} come within {clearance.distance:.6g} < required {required:.6g} on leg '
+        f'{what} come within {clearance.distance:.6g} {limit} on leg '
         f'{clearance.leg} ({result.leg_names[clearance.leg]} of segment C_{segment + 1} -> '
         f'C_{segment + 2}) at tau {clearance.tau:.6g}',
         configuration=segment, robots=[a] if clearance.kind == 'obstacle' else [a, b],

@@ -12,6 +12,9 @@ import numpy as np
 from .errors import ErrorCode, PlanningError
 from .pairs import pair_difference_matrix, point_pairs
 
+# Coordinates beyond this magnitude are refused: squared distances must not
+# overflow, and the certificate's resolution (1e-12 of the scale) stays useful.
+MAX_COORDINATE = 1e15
 # Up to this many robots, coincidences are found by comparing every pair.
 _PAIRWISE_ROBOTS = 32
 
@@ -103,6 +106,13 @@ def validate_configurations(configurations, obstacles):
         raise PlanningError(ErrorCode.NON_FINITE_VALUE,
                             f'configuration {m}, robot {robot}: coordinate {axis} is '
                             f'{configurations[m, robot, axis]}', configuration=m, robots=[robot])
+    too_far = np.abs(configurations) > MAX_COORDINATE
+    if too_far.any():
+        m, robot, axis = (int(v) for v in np.argwhere(too_far)[0])
+        raise PlanningError(ErrorCode.INVALID_REQUEST,
+                            f'configuration {m}, robot {robot}: coordinate {axis} is '
+                            f'{configurations[m, robot, axis]:.6g}, beyond the supported '
+                            f'range +-{MAX_COORDINATE:.0e}', configuration=m, robots=[robot])
     coincident, on_obstacle = _coincidences(configurations, obstacles)
     if coincident is not None:
         m, a, b = coincident
