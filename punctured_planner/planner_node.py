@@ -1,49 +1,293 @@
 """
-Minimal planner node: serves ``plan_sequence`` and answers "not implemented yet".
+The planner node: topics and parameters in, PlanSequence service, a Path per robot out.
 
-This placeholder proves the foundation (interface package, install, DDS round
-trip). The real planner node replaces :class:`PlannerNode`; the service name,
-the entry point ``planner_node`` and the shutdown behaviour stay the same.
+A thin adapter: it keeps the latest obstacles, robot state and parameters under
+one lock, takes one snapshot of them per request (logged with its stamps),
+hands request and snapshot to :class:`punctured_planner.planning.Planner` (the
+checks and the core) and publishes the result. No math here; every message
+conversion is in :mod:`punctured_planner.conversions`.
+
+Obstacle rule: the latest of the two sources is the obstacle set. At start it
+is the ``obstacles`` parameter; a message on the ``obstacles`` topic replaces
+it; setting the parameter again replaces the topic's set, and so on.
+
+Robot state rule (``use_current_state``): the newer of the last ``robot_states``
+message and, when ``robot_names`` is set, the state assembled from every
+robot's ``<name>/odom`` (complete once each robot has reported; as old as its
+oldest message).
+
+Concurrency: a MultiThreadedExecutor; the service has its own mutually
+exclusive callback group (one plan at a time), the subscriptions another, so
+planning never blocks them. A plan is published only once it is complete.
 """
 
+import os
 import sys
+import threading
+import traceback
 
+from geometry_msgs.msg import PoseArray
+from nav_msgs.msg import Odometry
+from nav_msgs.msg import Path
+import numpy as np
 from punctured_planner_interfaces.srv import PlanSequence
+from rcl_interfaces.msg import SetParametersResult
 import rclpy
+from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
+from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.exceptions import ParameterException
 from rclpy.executors import ExternalShutdownException
+from rclpy.executors import MultiThreadedExecutor
 from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy
+from rclpy.qos import HistoryPolicy
+from rclpy.qos import QoSProfile
+from rclpy.qos import ReliabilityPolicy
+from std_msgs.msg import UInt32
+from visualization_msgs.msg import MarkerArray
 
-NOT_IMPLEMENTED_MSG = 'planner not implemented yet'
+from . import conversions
+from .parameters import descriptor
+from .parameters import NODE_NAME
+from .parameters import PARAMETERS
+from .parameters import settings_from_values
+from .parameters import SPECS
+from .planning import ObstacleSet
+from .planning import Planner
+from .planning import RobotState
+from .planning import Snapshot
+
+LATCHED = QoSProfile(depth=1, history=HistoryPolicy.KEEP_LAST,
+                     reliability=ReliabilityPolicy.RELIABLE,
+                     durability=DurabilityPolicy.TRANSIENT_LOCAL)
+# Robot state streams: best effort matches reliable and best-effort publishers alike.
+STATE = QoSProfile(depth=1, history=HistoryPolicy.KEEP_LAST,
+                   reliability=ReliabilityPolicy.BEST_EFFORT,
+                   durability=DurabilityPolicy.VOLATILE)
 
 
 class PlannerNode(Node):
-    """Serve PlanSequence; every request gets error_code UNKNOWN for now."""
+    """Serve ``plan_sequence``; publish each robot's Path, the domain index and markers."""
 
     def __init__(self, **kwargs):
-        """Create the node and its ``plan_sequence`` service (a relative name)."""
-        super().__init__('planner_node', **kwargs)
-        self._service = self.create_service(
-            PlanSequence, 'plan_sequence', self._on_plan_sequence)
+        """Declare the parameters, subscribe, advertise; raise ValueError for bad parameters."""
+        super().__init__(NODE_NAME, **kwargs)
+        self._lock = threading.Lock()
+        self._planner = Planner()
+        self._request_count = 0
+        for spec in PARAMETERS:
+            self.declare_parameter(spec.name, spec.default, descriptor(spec))
+        self._settings = settings_from_values(self._parameter_values())
+        self.add_on_set_parameters_callback(self._on_set_parameters)
+        self.add_post_set_parameters_callback(self._after_set_parameters)
+        self._obstacles = self._parameter_obstacles(self._settings)
+        self._robot_states = None  # (RobotState, received_ns)
+        self._odometry = {}  # name -> (position, orientation, frame_id, stamp_ns, received_ns)
+
+        self._input_group = ReentrantCallbackGroup()
+        self._service_group = MutuallyExclusiveCallbackGroup()
+        self.create_subscription(PoseArray, 'obstacles', self._on_obstacles, LATCHED,
+                                 callback_group=self._input_group)
+        self.create_subscription(PoseArray, 'robot_states', self._on_robot_states, STATE,
+                                 callback_group=self._input_group)
+        self._odometry_subscriptions = {}
+        self._update_odometry_subscriptions(self._settings.robot_names)
+        self._path_publishers = {}
+        self._latched_names = []
+        self._domain_publisher = self.create_publisher(UInt32, 'domain_index', LATCHED)
+        self._marker_publisher = self.create_publisher(MarkerArray, 'plan_markers', LATCHED)
+        self._service = self.create_service(PlanSequence, 'plan_sequence',
+                                            self._on_plan_sequence,
+                                            callback_group=self._service_group)
+        s = self._settings
         self.get_logger().info(
-            'serving %s (placeholder: %s)'
-            % (self.resolve_service_name('plan_sequence'), NOT_IMPLEMENTED_MSG))
+            'serving %s: frame %s, dimension %d, variant %s, %s, robots %s'
+            % (self.resolve_service_name('plan_sequence'), s.frame_id, s.dimension, s.variant,
+               self._obstacles.describe(),
+               ', '.join(s.robot_names) or (str(s.robot_count) if s.robot_count else 'any')))
+
+    # ------------------------------------------------------------ parameters
+
+    def _parameter_values(self):
+        return {name: self.get_parameter(name).value for name in SPECS}
+
+    def _on_set_parameters(self, parameters):
+        """Refuse a change that makes the settings invalid, with the reason."""
+        values = self._parameter_values()
+        values.update({p.name: p.value for p in parameters if p.name in SPECS})
+        try:
+            settings_from_values(values)
+        except ValueError as error:
+            return SetParametersResult(successful=False, reason=str(error))
+        return SetParametersResult(successful=True)
+
+    def _after_set_parameters(self, parameters):
+        """Take the accepted values into the settings the next request will use."""
+        changed = {p.name for p in parameters}
+        settings = settings_from_values(self._parameter_values())
+        with self._lock:
+            self._settings = settings
+            if 'obstacles' in changed:
+                self._obstacles = self._parameter_obstacles(settings)
+            if 'robot_names' in changed:
+                self._odometry = {name: value for name, value in self._odometry.items()
+                                  if name in settings.robot_names}
+        if 'robot_names' in changed:
+            self._update_odometry_subscriptions(settings.robot_names)
+        self.get_logger().info('parameters set: %s' % ', '.join(
+            '%s=%r' % (p.name, p.value) for p in parameters))
+
+    def _parameter_obstacles(self, settings):
+        return ObstacleSet(conversions.obstacles_from_parameter(settings.obstacles),
+                           frame_id='', source='parameter',
+                           stamp_ns=self.get_clock().now().nanoseconds)
+
+    # ------------------------------------------------------------ subscriptions
+
+    def _update_odometry_subscriptions(self, names):
+        for name in list(self._odometry_subscriptions):
+            if name not in names:
+                self.destroy_subscription(self._odometry_subscriptions.pop(name))
+        for name in names:
+            if name not in self._odometry_subscriptions:
+                self._odometry_subscriptions[name] = self.create_subscription(
+                    Odometry, name + '/odom',
+                    lambda msg, name=name: self._on_odometry(name, msg), STATE,
+                    callback_group=self._input_group)
+
+    def _on_obstacles(self, msg):
+        obstacles = ObstacleSet(conversions.obstacles_from_pose_array(msg),
+                                frame_id=msg.header.frame_id,
+                                source=self.resolve_topic_name('obstacles'),
+                                stamp_ns=conversions.stamp_to_ns(msg.header.stamp))
+        with self._lock:
+            self._obstacles = obstacles
+        self.get_logger().info('obstacles: %s' % obstacles.describe())
+
+    def _on_robot_states(self, msg):
+        state = RobotState(conversions.pose_array_positions(msg),
+                           conversions.pose_array_orientations(msg), msg.header.frame_id,
+                           conversions.stamp_to_ns(msg.header.stamp), 'robot_states')
+        received = self.get_clock().now().nanoseconds
+        with self._lock:
+            self._robot_states = (state, received)
+
+    def _on_odometry(self, name, msg):
+        position, orientation = conversions.odometry_pose(msg)
+        entry = (position, orientation, msg.header.frame_id,
+                 conversions.stamp_to_ns(msg.header.stamp), self.get_clock().now().nanoseconds)
+        with self._lock:
+            self._odometry[name] = entry
+
+    def _current_state(self, settings):
+        """Return (RobotState or None, why none); call with the lock held."""
+        candidates = []
+        if self._robot_states is not None:
+            candidates.append((self._robot_states[1], self._robot_states[0]))
+        names = settings.robot_names
+        missing = [name for name in names if name not in self._odometry]
+        if names and not missing:
+            entries = [self._odometry[name] for name in names]
+            frames = [e[2] for e in entries]
+            frame = next((f for f in frames if f and f != settings.frame_id), frames[0])
+            state = RobotState(np.stack([e[0] for e in entries]),
+                               np.stack([e[1] for e in entries]), frame,
+                               min(e[3] for e in entries), 'odometry of %s' % ', '.join(names))
+            candidates.append((min(e[4] for e in entries), state))
+        if candidates:
+            return max(candidates, key=lambda c: c[0])[1], ''
+        problem = 'no robot state received yet (topic robot_states'
+        if names:
+            problem += ', or odometry from %s' % ', '.join(n + '/odom' for n in missing)
+        return None, problem + ')'
+
+    def snapshot(self):
+        """Return one consistent Snapshot of parameters, obstacles and robot state."""
+        with self._lock:
+            settings = self._settings
+            state, problem = self._current_state(settings)
+            return Snapshot(settings, self._obstacles, state, problem)
+
+    # ------------------------------------------------------------ the service
 
     def _on_plan_sequence(self, request, response):
-        response.error_code = PlanSequence.Response.UNKNOWN
-        response.error_msg = NOT_IMPLEMENTED_MSG
+        now_ns = self.get_clock().now().nanoseconds
+        snapshot = self.snapshot()
+        self._request_count += 1
+        number = self._request_count
+        logger = self.get_logger()
+        logger.info('plan_sequence #%d: %d configurations%s; snapshot: %s'
+                    % (number, len(request.configurations),
+                       ' + current state' if request.use_current_state else '',
+                       snapshot.describe()))
+        outcome = self._planner.handle(request, response, snapshot, now_ns)
+        if outcome.ok:
+            try:
+                self._publish(outcome, snapshot.settings)
+            except Exception as error:  # noqa: B902 - never crash the service
+                logger.error('plan_sequence #%d: publishing failed: %r' % (number, error))
+                conversions.fill_error(response, PlanSequence.Response.UNKNOWN,
+                                       'internal error while publishing: %s' % error)
+                response.paths = []
+                return response
+            p = outcome.plan
+            logger.info('plan_sequence #%d: planned k=%d n=%d, domain %d of %d, clearance '
+                        '%.6g, %.3f ms' % (number, p.positions.shape[1],
+                                           len(p.waypoint_indices), p.domain_index,
+                                           p.domain_count, p.min_clearance,
+                                           response.planning_time.nanosec * 1e-6
+                                           + response.planning_time.sec * 1e3))
+        elif outcome.exception is not None:
+            logger.error('plan_sequence #%d: %s' % (number, response.error_msg))
+            logger.error(''.join(traceback.format_exception(outcome.exception)))
+        else:
+            logger.warn('plan_sequence #%d: error %d: %s'
+                        % (number, response.error_code, response.error_msg))
         return response
+
+    def _publish(self, outcome, settings):
+        """Publish the complete plan: every robot's Path, stale robots emptied, markers, index."""
+        markers = conversions.plan_markers(outcome.plan, settings.frame_id, outcome.start_ns,
+                                           settings.plane_z, outcome.names)
+        index = conversions.domain_index_message(outcome.plan)
+        publishers = [self._path_publisher(name) for name in outcome.names]
+        stale = [name for name in self._latched_names if name not in set(outcome.names)]
+        for publisher, path in zip(publishers, outcome.paths):
+            publisher.publish(path)
+        for name in stale:
+            self._path_publisher(name).publish(
+                conversions.empty_path(settings.frame_id, outcome.start_ns))
+        self._latched_names = list(outcome.names)
+        self._marker_publisher.publish(markers)
+        self._domain_publisher.publish(index)
+
+    def _path_publisher(self, name):
+        publisher = self._path_publishers.get(name)
+        if publisher is None:
+            publisher = self.create_publisher(Path, name + '/plan', LATCHED)
+            self._path_publishers[name] = publisher
+        return publisher
 
 
 def main(args=None):
-    """Run the node in the foreground until Ctrl-C or SIGTERM."""
+    """Run the node until Ctrl-C or SIGTERM; return 0, or 2 for invalid parameters."""
     rclpy.init(args=args)
     node = None
+    executor = None
     try:
-        node = PlannerNode()
-        rclpy.spin(node)
+        try:
+            node = PlannerNode()
+        except (ValueError, ParameterException) as error:
+            print('planner_node: invalid parameters: %s' % error, file=sys.stderr)
+            return 2
+        executor = MultiThreadedExecutor(num_threads=max(4, os.cpu_count() or 1))
+        executor.add_node(node)
+        executor.spin()
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
+        if executor is not None:
+            executor.shutdown()
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()

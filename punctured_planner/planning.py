@@ -1,0 +1,313 @@
+"""
+One PlanSequence request against one snapshot: the ROS-level checks, then the core.
+
+This is the service's logic without the ROS graph: the node calls it with a
+snapshot of its subscriptions and parameters, ``punctured-planner plan`` calls
+it offline with a parameter file. The checks here are only the ROS-level ones,
+in the priority order of the error codes (the smallest code wins):
+
+1. NO_CONFIGURATIONS, 2. NO_ROBOT_STATE, 3. REQUEST_OVER_LIMITS (from list
+lengths, before any conversion or allocation), 4. INVALID_REQUEST,
+5. ROBOT_COUNT_MISMATCH, 6. NON_FINITE_VALUE, 7. FRAME_MISMATCH, 8. OFF_PLANE;
+then the core's own checks (9 OBSTACLES_DEGENERATE, 10 ROBOTS_COINCIDE,
+11 ROBOT_ON_OBSTACLE, 12 CLEARANCE_BELOW_REQUIRED). The finiteness check runs
+here, before the frame and plane checks, because its code comes first and in
+planar mode the core never sees z.
+"""
+
+from collections import OrderedDict
+from dataclasses import dataclass
+import math
+import threading
+import time
+
+import numpy as np
+
+from . import conversions
+from .core import ErrorCode, plan as core_plan, PlanningError, Workspace
+from .core.sections import PAPER_LEGS, SPREAD_LEGS
+from .parameters import MAX_SAMPLES_PER_LEG
+
+# Largest |z - plane_z| accepted in planar mode (m).
+PLANE_TOLERANCE = 1e-9
+_AXES = 'xyz'
+
+
+@dataclass(frozen=True)
+class ObstacleSet:
+    """The obstacles of a snapshot: (r, 3) points, their frame and where they came from."""
+
+    points: np.ndarray
+    frame_id: str = ''
+    source: str = 'parameter'
+    stamp_ns: int = 0
+
+    def describe(self):
+        """Return a short text for the log: count, source and stamp."""
+        if self.source == 'parameter':
+            return '%d obstacles from the parameter' % len(self.points)
+        return '%d obstacles from topic %s (stamp %.9f)' % (
+            len(self.points), self.source, self.stamp_ns * 1e-9)
+
+
+@dataclass(frozen=True)
+class RobotState:
+    """The current robot state: positions (k, 3), orientations (k, 4), frame, stamp, source."""
+
+    positions: np.ndarray
+    orientations: np.ndarray
+    frame_id: str = ''
+    stamp_ns: int = 0
+    source: str = 'robot_states'
+
+    def describe(self):
+        """Return a short text for the log: robots, source and stamp."""
+        return '%d robots from %s (stamp %.9f)' % (
+            len(self.positions), self.source, self.stamp_ns * 1e-9)
+
+
+@dataclass(frozen=True)
+class Snapshot:
+    """Everything one request is planned against, taken at once under the node's lock."""
+
+    settings: object
+    obstacles: ObstacleSet
+    state: RobotState = None
+    state_problem: str = 'no robot state received yet (topic robot_states)'
+
+    def describe(self):
+        """Return the log line of the snapshot."""
+        state = self.state.describe() if self.state is not None else 'no robot state'
+        return '%s; %s' % (self.obstacles.describe(), state)
+
+
+@dataclass
+class Outcome:
+    """The answer to one request: the filled response and, on success, the plan."""
+
+    response: object
+    plan: object = None
+    paths: list = None
+    names: list = None
+    start_ns: int = 0
+    max_speed: float = 0.0
+    exception: BaseException = None
+    core_input: tuple = None  # (workspace, configurations) given to the core
+
+    @property
+    def ok(self):
+        """Return whether the request was planned (error_code NONE)."""
+        return self.response.error_code == ErrorCode.NONE
+
+
+def _fail(code, message, configuration=None, robots=(), obstacle=None):
+    raise PlanningError(code, message, configuration=configuration, robots=robots,
+                        obstacle=obstacle)
+
+
+class Planner:
+    """Answers PlanSequence requests; keeps the last few Workspaces (one per obstacle set)."""
+
+    def __init__(self, cache_size=4):
+        """Create an empty workspace cache."""
+        self._cache = OrderedDict()
+        self._cache_size = cache_size
+        self._lock = threading.Lock()
+
+    def workspace(self, settings, obstacles):
+        """
+        Return the Workspace for planar/3-D obstacles (r, d) and the settings (cached).
+
+        The frame is fixed per obstacle set and options, so equal obstacle sets
+        give the same Workspace object (and the same domains). Raises PlanningError.
+        """
+        obstacles = np.ascontiguousarray(obstacles, dtype=float)
+        key = (obstacles.shape, obstacles.tobytes(), settings.dimension, settings.variant,
+               settings.lane_spacing, settings.min_spacing, settings.required_clearance)
+        with self._lock:
+            found = self._cache.get(key)
+            if found is not None:
+                self._cache.move_to_end(key)
+                return found
+        workspace = Workspace(obstacles, dimension=settings.dimension,
+                              lane_spacing=settings.lane_spacing, variant=settings.variant,
+                              min_spacing=settings.min_spacing,
+                              required_clearance=settings.required_clearance)
+        with self._lock:
+            self._cache[key] = workspace
+            while len(self._cache) > self._cache_size:
+                self._cache.popitem(last=False)
+        return workspace
+
+    def handle(self, request, response, snapshot, now_ns):
+        """
+        Answer ``request`` against ``snapshot``; return an Outcome (never raises).
+
+        now_ns is the request time; the paths start at now_ns + planning time.
+        Unexpected exceptions become error_code UNKNOWN with their message (and
+        are kept in Outcome.exception for the log).
+        """
+        started = time.perf_counter()
+        outcome = Outcome(response=response)
+        try:
+            self._plan(request, snapshot, now_ns, started, outcome)
+        except PlanningError as error:
+            minimum = None
+            if error.code == ErrorCode.CLEARANCE_BELOW_REQUIRED:
+                minimum = self._clearance_found(outcome)
+            conversions.fill_error(response, error.code, self._message(error, request),
+                                   time.perf_counter() - started, minimum)
+            outcome.plan = outcome.paths = None
+        except Exception as error:  # noqa: B902 - any bug becomes UNKNOWN, the node serves on
+            conversions.fill_error(response, ErrorCode.UNKNOWN,
+                                   'internal error: %s: %s' % (type(error).__name__, error),
+                                   time.perf_counter() - started)
+            outcome.plan = outcome.paths = None
+            outcome.exception = error
+        return outcome
+
+    @staticmethod
+    def _message(error, request):
+        message = str(error.args[0]) if error.args else error.code.name
+        if request.use_current_state and error.configuration is not None:
+            message += (' (configuration 0 is the current robot state, configuration m is '
+                        'configurations[m - 1] of the request)')
+        return message
+
+    @staticmethod
+    def _clearance_found(outcome):
+        """Return the certified clearance of the refused plan (CLEARANCE_BELOW_REQUIRED)."""
+        if outcome.core_input is None:
+            return None
+        workspace, configurations = outcome.core_input
+        return core_plan(workspace, configurations, certify=False).min_clearance
+
+    def _plan(self, request, snapshot, now_ns, started, outcome):
+        settings = snapshot.settings
+        configurations = list(request.configurations)
+        use_state = bool(request.use_current_state)
+        state = snapshot.state if use_state else None
+        n = len(configurations) + (1 if use_state else 0)
+        if n < 2:
+            _fail(ErrorCode.NO_CONFIGURATIONS,
+                  'need at least 2 configurations in total, got %d (%d in the request%s)'
+                  % (n, len(configurations), ' + the current state' if use_state else ''))
+        if use_state and state is None:
+            _fail(ErrorCode.NO_ROBOT_STATE,
+                  'use_current_state is set but ' + snapshot.state_problem)
+        counts = ([len(state.positions)] if state is not None else []) + [
+            len(c.poses) for c in configurations]
+        self._check_limits(request, settings, n, counts)
+        max_speed = request.max_speed
+        if not math.isfinite(max_speed):
+            _fail(ErrorCode.INVALID_REQUEST, 'max_speed must be finite, got %r' % max_speed)
+        max_speed = max_speed if max_speed > 0 else settings.max_speed
+        samples = (request.samples_per_leg if request.samples_per_leg >= 0
+                   else settings.samples_per_leg)
+        label = self._labeller(use_state)
+        for m, count in enumerate(counts):
+            if count == 0:
+                _fail(ErrorCode.INVALID_REQUEST, '%s has no robots' % label(m), configuration=m)
+        for m, count in enumerate(counts):
+            if count != counts[0]:
+                _fail(ErrorCode.ROBOT_COUNT_MISMATCH, '%s has %d robots, %s has %d'
+                      % (label(m), count, label(0), counts[0]), configuration=m)
+        expected = settings.expected_robot_count
+        if expected and counts[0] != expected:
+            what = ('the %d robot_names' % expected if settings.robot_names
+                    else 'robot_count %d' % expected)
+            _fail(ErrorCode.ROBOT_COUNT_MISMATCH, '%s has %d robots but the node is configured '
+                  'for %s' % (label(0), counts[0], what), configuration=0)
+
+        positions, orientations = conversions.configurations_to_arrays(configurations)
+        frames = [c.header.frame_id for c in configurations]
+        if state is not None:
+            positions = np.concatenate([state.positions[None], positions])
+            orientations = np.concatenate([state.orientations[None], orientations])
+            frames.insert(0, state.frame_id)
+        obstacles = snapshot.obstacles
+        self._check_values(settings, positions, frames, obstacles, label)
+
+        d = settings.dimension
+        workspace = self.workspace(settings, conversions.planar(obstacles.points, d))
+        planar = conversions.planar(positions, d)
+        outcome.core_input = (workspace, planar)
+        the_plan = core_plan(workspace, planar)
+        planning_time = time.perf_counter() - started
+        start_ns = int(now_ns) + int(round(planning_time * 1e9))
+        paths = conversions.plan_to_paths(the_plan, orientations, settings.frame_id, start_ns,
+                                          max_speed, samples, settings.plane_z)
+        conversions.fill_response(outcome.response, the_plan, paths, planning_time, max_speed)
+        outcome.plan, outcome.paths = the_plan, paths
+        outcome.names = conversions.robot_names(settings.robot_names, counts[0])
+        outcome.start_ns, outcome.max_speed = start_ns, max_speed
+
+    @staticmethod
+    def _labeller(use_state):
+        def label(m):
+            if not use_state:
+                return 'configuration %d' % m
+            if m == 0:
+                return 'configuration 0 (the current robot state)'
+            return 'configuration %d (request configurations[%d])' % (m, m - 1)
+        return label
+
+    @staticmethod
+    def _check_limits(request, settings, n, counts):
+        """REQUEST_OVER_LIMITS from lengths alone, before anything is converted."""
+        if n > settings.max_configurations:
+            _fail(ErrorCode.REQUEST_OVER_LIMITS, '%d configurations, more than '
+                  'max_configurations %d' % (n, settings.max_configurations))
+        k = max(counts)
+        if k > settings.max_robots:
+            m = counts.index(k)
+            _fail(ErrorCode.REQUEST_OVER_LIMITS, 'configuration %d has %d robots, more than '
+                  'max_robots %d' % (m, k, settings.max_robots), configuration=m)
+        samples = (request.samples_per_leg if request.samples_per_leg >= 0
+                   else settings.samples_per_leg)
+        if samples > MAX_SAMPLES_PER_LEG:
+            _fail(ErrorCode.REQUEST_OVER_LIMITS, 'samples_per_leg %d is more than %d'
+                  % (samples, MAX_SAMPLES_PER_LEG))
+        legs = len(SPREAD_LEGS if settings.variant == 'spread' else PAPER_LEGS)
+        poses = k * ((n - 1) * legs * (samples + 1) + 1)
+        if poses > settings.max_poses:
+            _fail(ErrorCode.REQUEST_OVER_LIMITS, 'the answer would hold %d poses (%d robots x '
+                  '%d poses), more than max_poses %d' % (poses, k, poses // max(k, 1),
+                                                         settings.max_poses))
+
+    @staticmethod
+    def _check_values(settings, positions, frames, obstacles, label):
+        """NON_FINITE_VALUE, FRAME_MISMATCH and OFF_PLANE, in that order."""
+        bad = conversions.first_non_finite(positions)
+        if bad is not None:
+            m, robot, axis = bad
+            _fail(ErrorCode.NON_FINITE_VALUE, '%s, robot %d: %s is %r'
+                  % (label(m), robot, _AXES[axis], float(positions[bad])),
+                  configuration=m, robots=[robot])
+        bad = conversions.first_non_finite(obstacles.points)
+        if bad is not None:
+            _fail(ErrorCode.NON_FINITE_VALUE, 'obstacle %d (%s): %s is %r'
+                  % (bad[0], obstacles.source, _AXES[bad[1]], float(obstacles.points[bad])),
+                  obstacle=bad[0])
+        for m, frame_id in enumerate(frames):
+            if frame_id and frame_id != settings.frame_id:
+                _fail(ErrorCode.FRAME_MISMATCH, "%s is in frame '%s', the planning frame is "
+                      "'%s'" % (label(m), frame_id, settings.frame_id), configuration=m)
+        if obstacles.frame_id and obstacles.frame_id != settings.frame_id:
+            _fail(ErrorCode.FRAME_MISMATCH, "the obstacles (%s) are in frame '%s', the "
+                  "planning frame is '%s'" % (obstacles.source, obstacles.frame_id,
+                                              settings.frame_id))
+        if settings.dimension != 2:
+            return
+        off = np.abs(positions[..., 2] - settings.plane_z) > PLANE_TOLERANCE
+        if off.any():
+            m, robot = (int(i) for i in np.argwhere(off)[0])
+            _fail(ErrorCode.OFF_PLANE, '%s, robot %d: z = %r but plane_z is %r (dimension 2)'
+                  % (label(m), robot, float(positions[m, robot, 2]), settings.plane_z),
+                  configuration=m, robots=[robot])
+        off = np.abs(obstacles.points[:, 2] - settings.plane_z) > PLANE_TOLERANCE
+        if off.any():
+            j = int(np.argmax(off))
+            _fail(ErrorCode.OFF_PLANE, 'obstacle %d (%s): z = %r but plane_z is %r (dimension 2)'
+                  % (j, obstacles.source, float(obstacles.points[j, 2]), settings.plane_z),
+                  obstacle=j)
