@@ -5,9 +5,16 @@ Command-line client ``punctured-planner``.
 running planner node and prints the response as YAML; it does the job of
 ``ros2 service call`` where ros2cli is not installed (ROS 2 from PyPI wheels).
 The request file has the same shape as the ``ros2 service call`` payload.
+
+``punctured-planner plan REQUEST.yaml [--params FILE]`` answers the same
+request offline, without a ROS graph: the node's checks and conversions
+(:mod:`punctured_planner.planning`) with the parameters of a ROS parameter
+file; ``--png``/``--gif`` draw the plan and ``--mcap`` records it as the node
+would publish it.
 """
 
 import argparse
+import os
 import sys
 import time
 
@@ -56,8 +63,6 @@ def _call(args):
     import rclpy
     from rclpy.executors import SingleThreadedExecutor
 
-    from punctured_planner.msg_dict import constant_names
-    from punctured_planner.msg_dict import message_to_dict
     from punctured_planner_interfaces.srv import PlanSequence
 
     try:
@@ -82,26 +87,92 @@ def _call(args):
             print('punctured-planner: no response from %s within %.1f s'
                   % (args.service, args.timeout), file=sys.stderr)
             return EXIT_NO_SERVICE
-        data = message_to_dict(response)
-        if args.no_paths:
-            data['paths'] = '(%d paths omitted)' % len(response.paths)
-        yaml.safe_dump(data, sys.stdout, sort_keys=False)
-        names = [n for n in constant_names(PlanSequence.Response, response.error_code)
-                 if n != 'NONE' or response.error_code == 0]
-        print('# error_code %d (%s)%s' % (
-            response.error_code, '/'.join(names) or 'undocumented',
-            ': ' + response.error_msg if response.error_msg else ''), file=sys.stderr)
-        if response.error_code != PlanSequence.Response.NONE:
-            return EXIT_PLANNER_ERROR
-        return EXIT_OK
+        return print_response(response, args.no_paths)
     finally:
         executor.shutdown()
         node.destroy_node()
         rclpy.try_shutdown(context=context)
 
 
-def make_parser():
-    """Return the argument parser of ``punctured-planner``."""
+def print_response(response, no_paths=False):
+    """Print a PlanSequence response as YAML (code name on stderr); return the exit code."""
+    from punctured_planner.msg_dict import constant_names
+    from punctured_planner.msg_dict import message_to_dict
+    from punctured_planner_interfaces.srv import PlanSequence
+
+    data = message_to_dict(response)
+    if no_paths:
+        data['paths'] = '(%d paths omitted)' % len(response.paths)
+    yaml.safe_dump(data, sys.stdout, sort_keys=False)
+    names = [n for n in constant_names(PlanSequence.Response, response.error_code)
+             if n != 'NONE' or response.error_code == 0]
+    print('# error_code %d (%s)%s' % (
+        response.error_code, '/'.join(names) or 'undocumented',
+        ': ' + response.error_msg if response.error_msg else ''), file=sys.stderr)
+    if response.error_code != PlanSequence.Response.NONE:
+        return EXIT_PLANNER_ERROR
+    return EXIT_OK
+
+
+def offline_plan(request, settings, now_ns=None):
+    """
+    Answer a PlanSequence request without a ROS graph; return the planning Outcome.
+
+    The obstacles come from the ``obstacles`` parameter; there is no robot
+    state, so ``use_current_state`` gets NO_ROBOT_STATE.
+    """
+    from punctured_planner import conversions
+    from punctured_planner.planning import ObstacleSet
+    from punctured_planner.planning import Planner
+    from punctured_planner.planning import Snapshot
+    from punctured_planner_interfaces.srv import PlanSequence
+
+    snapshot = Snapshot(
+        settings, ObstacleSet(conversions.obstacles_from_parameter(settings.obstacles)),
+        state=None, state_problem='punctured-planner plan has no robot state (no ROS graph)')
+    now_ns = time.time_ns() if now_ns is None else now_ns
+    return Planner().handle(request, PlanSequence.Response(), snapshot, now_ns)
+
+
+def _plan(args):
+    from punctured_planner.parameters import load_parameter_file
+    from punctured_planner.parameters import settings_from_values
+    from punctured_planner.recording import record_plan
+    from punctured_planner.render import render_outputs
+
+    try:
+        values = load_parameter_file(args.params) if args.params else {}
+        settings = settings_from_values(values)
+    except (OSError, yaml.YAMLError, ValueError) as error:
+        print('punctured-planner: bad parameter file: %s' % error, file=sys.stderr)
+        return EXIT_USAGE
+    try:
+        request = build_request(load_request(args.request))
+    except (OSError, yaml.YAMLError, ValueError) as error:
+        print('punctured-planner: bad request: %s' % error, file=sys.stderr)
+        return EXIT_USAGE
+    outcome = offline_plan(request, settings)
+    if outcome.exception is not None:
+        print('punctured-planner: %r' % outcome.exception, file=sys.stderr)
+    code = print_response(outcome.response, args.no_paths)
+    if not outcome.ok:
+        return code
+    title = os.path.basename(args.request) if args.request != '-' else None
+    written = render_outputs(args, outcome.plan, title=title)
+    if args.mcap:
+        written.append(record_plan(args.mcap, outcome, settings))
+    for path in written:
+        print('# wrote %s' % path, file=sys.stderr)
+    return code
+
+
+def make_parser(pictures=True):
+    """
+    Return the argument parser of ``punctured-planner``.
+
+    pictures=False leaves out the picture options of ``plan`` (they import
+    matplotlib, which ``call`` does not need).
+    """
     parser = argparse.ArgumentParser(
         prog='punctured-planner',
         description='Client tools for the punctured_planner ROS 2 node.')
@@ -118,12 +189,29 @@ def make_parser():
     call.add_argument('--no-paths', action='store_true',
                       help='print only the number of paths, not the poses')
     call.set_defaults(func=_call)
+    plan = commands.add_parser(
+        'plan', help='plan a request (YAML file) offline, without a ROS graph, and print '
+        'the response; optionally draw or record the plan')
+    plan.add_argument('request', help="YAML request file, '-' for standard input")
+    plan.add_argument('--params', metavar='FILE',
+                      help='ROS parameter file of planner_node, e.g. '
+                      'config/default_scenario.yaml (default: the built-in defaults)')
+    plan.add_argument('--no-paths', action='store_true',
+                      help='print only the number of paths, not the poses')
+    plan.add_argument('--mcap', metavar='OUT.mcap',
+                      help="record the plan as the node publishes it (each robot's "
+                      'Path, the markers, the domain index) for Foxglove / ros2 bag')
+    if pictures:
+        from punctured_planner.render import add_render_arguments
+        add_render_arguments(plan)
+    plan.set_defaults(func=_plan, png=None, gif=None)
     return parser
 
 
 def main(argv=None):
     """Entry point of the ``punctured-planner`` console script."""
-    args = make_parser().parse_args(argv)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args = make_parser(pictures=argv[:1] != ['call']).parse_args(argv)
     try:
         return args.func(args)
     except KeyboardInterrupt:

@@ -1,0 +1,169 @@
+"""
+A plan as an MCAP recording: what the node would publish, for Foxglove and ``ros2 bag``.
+
+The file follows the MCAP ``ros2`` profile: CDR messages serialised by the
+real ROS 2 type support (``rclpy.serialization``), one schema per type in the
+``ros2msg`` encoding whose text is the complete message definition assembled
+from the installed ``.msg`` files (the top-level definition, then every nested
+type after a line of 80 ``=`` and ``MSG: pkg/msg/Type``, as rosbag2 writes it).
+
+Channels (absolute topic names, as ``ros2 bag`` records them):
+
+* ``/<robot_name>/plan`` nav_msgs/msg/Path, one per robot;
+* ``/plan_markers`` visualization_msgs/msg/MarkerArray;
+* ``/domain_index`` std_msgs/msg/UInt32.
+
+Every message is logged at the plan's start stamp. A metadata record
+``punctured_planner`` carries the plan's figures (domain, clearance, ...).
+"""
+
+import importlib
+import os
+import re
+
+_SEPARATOR = '=' * 80
+_PRIMITIVES = {'bool', 'byte', 'char', 'float32', 'float64', 'int8', 'uint8', 'int16',
+               'uint16', 'int32', 'uint32', 'int64', 'uint64', 'string', 'wstring'}
+_FIELD = re.compile(r'^\s*(?P<type>[A-Za-z][\w/]*)(?P<array>\[[^\]]*\])?(?:<=\d+)?\s+\w+')
+
+
+def _share_prefixes(package):
+    """Return the install prefixes where ``share/<package>`` may be, best first."""
+    prefixes = [p for p in os.environ.get('AMENT_PREFIX_PATH', '').split(os.pathsep) if p]
+    try:
+        module = importlib.import_module(package)
+        # <prefix>/lib/pythonX.Y/site-packages/<package>/__init__.py
+        here = os.path.dirname(os.path.abspath(module.__file__))
+        prefixes.append(os.path.dirname(os.path.dirname(os.path.dirname(
+            os.path.dirname(here)))))
+    except ImportError:
+        pass
+    return prefixes
+
+
+def message_definition_file(type_name):
+    """Return the path of the installed .msg file of ``pkg/msg/Type``; raise LookupError."""
+    package, _, name = type_name.split('/')
+    for prefix in _share_prefixes(package):
+        path = os.path.join(prefix, 'share', package, 'msg', name + '.msg')
+        if os.path.isfile(path):
+            return path
+    raise LookupError('no installed definition %s.msg for %s' % (name, type_name))
+
+
+def _dependencies(text, package):
+    """Return the complex field types of a .msg text as 'pkg/msg/Type' names, in order."""
+    found = []
+    for line in text.splitlines():
+        line = line.split('#', 1)[0]
+        match = _FIELD.match(line)
+        if not match:
+            continue  # blank, comment; constants and defaults have primitive types
+        field_type = match.group('type')
+        if field_type in _PRIMITIVES:
+            continue
+        if '/' in field_type:
+            pkg, _, name = field_type.rpartition('/')
+            pkg = pkg.split('/')[0]
+        else:
+            pkg, name = package, field_type
+        full = '%s/msg/%s' % (pkg, name)
+        if full not in found:
+            found.append(full)
+    return found
+
+
+def message_definition(type_name):
+    """
+    Return the complete ros2msg definition text of ``pkg/msg/Type``.
+
+    The type's own .msg text first, then each nested type once (depth first)
+    after an 80-character ``=`` line and ``MSG: pkg/msg/Type``.
+    """
+    texts = {}
+    order = []
+
+    def visit(name):
+        with open(message_definition_file(name), encoding='utf-8') as stream:
+            text = stream.read()
+        texts[name] = text
+        for dependency in _dependencies(text, name.split('/')[0]):
+            if dependency not in texts:
+                order.append(dependency)
+                visit(dependency)
+
+    visit(type_name)
+    parts = [texts[type_name].rstrip('\n')]
+    for name in order:
+        parts.append('%s\nMSG: %s\n%s' % (_SEPARATOR, name, texts[name].rstrip('\n')))
+    return '\n'.join(parts) + '\n'
+
+
+def _type_name(message):
+    """Return 'pkg/msg/Type' of a generated ROS 2 message instance."""
+    module = type(message).__module__.split('.')
+    return '%s/msg/%s' % (module[0], type(message).__name__)
+
+
+def plan_messages(outcome, settings):
+    """Return [(topic, message)] of a successful planning Outcome, as the node publishes."""
+    from . import conversions
+    messages = [('/%s/plan' % name.strip('/'), path)
+                for name, path in zip(outcome.names, outcome.paths)]
+    messages.append(('/plan_markers', conversions.plan_markers(
+        outcome.plan, settings.frame_id, outcome.start_ns, settings.plane_z, outcome.names)))
+    messages.append(('/domain_index', conversions.domain_index_message(outcome.plan)))
+    return messages
+
+
+def write_mcap(path, messages, log_time_ns, metadata=None):
+    """
+    Write [(topic, message)] to an MCAP file at ``path``; return the path.
+
+    Each message is serialised by rclpy (exact CDR) and logged at
+    ``log_time_ns``; metadata (dict of str) goes into a ``punctured_planner``
+    metadata record.
+    """
+    from mcap.well_known import MessageEncoding
+    from mcap.well_known import Profile
+    from mcap.well_known import SchemaEncoding
+    from mcap.writer import Writer
+    from rclpy.serialization import serialize_message
+
+    schemas = {}
+    channels = {}
+    with open(path, 'wb') as stream:
+        writer = Writer(stream)
+        writer.start(profile=Profile.ROS2, library='punctured_planner')
+        for sequence, (topic, message) in enumerate(messages):
+            type_name = _type_name(message)
+            if type_name not in schemas:
+                schemas[type_name] = writer.register_schema(
+                    name=type_name, encoding=SchemaEncoding.ROS2,
+                    data=message_definition(type_name).encode('utf-8'))
+            if topic not in channels:
+                channels[topic] = writer.register_channel(
+                    topic=topic, message_encoding=MessageEncoding.CDR,
+                    schema_id=schemas[type_name])
+            writer.add_message(channel_id=channels[topic], log_time=int(log_time_ns),
+                               publish_time=int(log_time_ns), sequence=sequence,
+                               data=serialize_message(message))
+        if metadata:
+            writer.add_metadata('punctured_planner',
+                                {str(k): str(v) for k, v in metadata.items()})
+        writer.finish()
+    return path
+
+
+def record_plan(path, outcome, settings):
+    """Write a successful planning Outcome to an MCAP file (see the module docstring)."""
+    p = outcome.plan
+    metadata = {
+        'domain_index': p.domain_index, 'domain_count': p.domain_count,
+        'domain': p.domain, 'sequential_complexity': p.sequential_complexity or 0,
+        'optimal': p.optimal, 'min_clearance': repr(float(p.min_clearance)),
+        'variant': p.variant, 'frame_id': settings.frame_id,
+        'max_speed': outcome.max_speed, 'robots': ','.join(outcome.names),
+        'projection_counts': ','.join(str(int(c)) for c in p.projection_counts),
+    }
+    return write_mcap(path, plan_messages(outcome, settings), outcome.start_ns, metadata)
