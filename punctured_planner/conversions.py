@@ -155,10 +155,7 @@ def plan_to_paths(plan, orientations, frame_id, start_ns, max_speed, samples_per
     the stamp of the first pose. All paths share one Header object per stamp, so
     their stamps are identical by construction.
     """
-    from geometry_msgs.msg import Point
-    from geometry_msgs.msg import Pose
     from geometry_msgs.msg import PoseStamped
-    from geometry_msgs.msg import Quaternion
     from nav_msgs.msg import Path
     from std_msgs.msg import Header
 
@@ -168,19 +165,23 @@ def plan_to_paths(plan, orientations, frame_id, start_ns, max_speed, samples_per
     offsets = np.rint(seconds * 1e9).astype(np.int64)
     headers = [Header(frame_id=frame_id, stamp=time_from_ns(start_ns + int(offset)))
                for offset in offsets]
-    samples, robot_count = xyz.shape[:2]
     xyz_list = xyz.transpose(1, 0, 2).tolist()
     held = quaternions[waypoint].transpose(1, 0, 2).tolist()
     paths = []
-    for i in range(robot_count):
-        path = Path(header=Header(frame_id=frame_id, stamp=time_from_ns(start_ns)))
+    for robot_xyz, robot_held in zip(xyz_list, held):
         poses = []
-        for j in range(samples):
-            x, y, z = xyz_list[i][j]
-            qx, qy, qz, qw = held[i][j]
-            poses.append(PoseStamped(header=headers[j], pose=Pose(
-                position=Point(x=x, y=y, z=z),
-                orientation=Quaternion(x=qx, y=qy, z=qz, w=qw))))
+        for header, (x, y, z), (qx, qy, qz, qw) in zip(headers, robot_xyz, robot_held):
+            # Fill a default PoseStamped in place: its constructor builds the nested
+            # defaults anyway, so passing new nested messages would build them twice.
+            stamped = PoseStamped()
+            stamped.header = header
+            pose = stamped.pose
+            position = pose.position
+            position.x, position.y, position.z = x, y, z
+            orientation = pose.orientation
+            orientation.x, orientation.y, orientation.z, orientation.w = qx, qy, qz, qw
+            poses.append(stamped)
+        path = Path(header=Header(frame_id=frame_id, stamp=time_from_ns(start_ns)))
         path.poses = poses
         paths.append(path)
     return paths
@@ -205,7 +206,12 @@ def _colour(index, alpha=1.0):
 
 def _points(xyz):
     from geometry_msgs.msg import Point
-    return [Point(x=x, y=y, z=z) for x, y, z in np.asarray(xyz, dtype=float).tolist()]
+    points = []
+    for x, y, z in np.asarray(xyz, dtype=float).tolist():
+        point = Point()
+        point.x, point.y, point.z = x, y, z
+        points.append(point)
+    return points
 
 
 def plan_markers(plan, frame_id, stamp_ns, plane_z=0.0, names=None):
@@ -213,8 +219,8 @@ def plan_markers(plan, frame_id, stamp_ns, plane_z=0.0, names=None):
     Return a visualization_msgs/MarkerArray of the plan for RViz.
 
     Namespaces: a DELETEALL first (no stale markers), ``obstacles`` (black
-    spheres), ``axis`` (the e1 axis, grey), ``lanes`` (one line per robot
-    lane, dashed as a LINE_LIST), ``paths`` (one LINE_STRIP per robot through
+    spheres), ``axis`` (the e1 axis, grey), ``lanes`` (one thin line per
+    robot lane, a LINE_LIST), ``paths`` (one LINE_STRIP per robot through
     every breakpoint, robot colours), ``waypoints`` (one SPHERE_LIST per
     configuration C_m) and ``labels`` (robot names at C_1).
     """
@@ -249,11 +255,10 @@ def plan_markers(plan, frame_id, stamp_ns, plane_z=0.0, names=None):
     axis = to_xyz(frame.axis_points(np.array([low, high])), plane_z)
     markers.append(marker('axis', 0, Marker.LINE_STRIP,
                           ColorRGBA(r=0.5, g=0.5, b=0.5, a=0.8), width, axis))
-    lanes = []
-    dashes = np.linspace(low, high, 41)
-    for height in np.asarray(plan.lanes, dtype=float).tolist():
-        line = frame.axis_points(dashes) + height * frame.e2
-        lanes.extend(to_xyz(line, plane_z)[:40])
+    ends = frame.axis_points(np.array([low, high]))
+    heights = np.asarray(plan.lanes, dtype=float)
+    lanes = to_xyz(ends[None, :, :] + heights[:, None, None] * frame.e2,
+                   plane_z).reshape(-1, 3)
     markers.append(marker('lanes', 0, Marker.LINE_LIST,
                           ColorRGBA(r=0.6, g=0.6, b=0.6, a=0.5), 0.5 * width, lanes))
     for i in range(k):

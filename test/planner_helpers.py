@@ -1,0 +1,143 @@
+"""
+Helpers for the planner node tests: requests, an in-process node, latched subscribers.
+
+The in-process node runs in its own rclpy Context with a MultiThreadedExecutor
+spinning in a background thread (as ``main()`` runs it); the test talks to it
+over real DDS from the ``ros_client`` fixture's own Context.
+"""
+
+import itertools
+import os
+import threading
+import time
+
+import numpy as np
+import pytest
+
+OBSTACLES = [[-2.0, 0.5, 0.0], [0.0, -0.5, 0.0], [2.5, 0.0, 0.0]]
+# Four robots through three configurations, clear of the obstacles (z = 0).
+CONFIGURATIONS = [
+    [[-3.0, -2.0, 0.0], [-1.0, -2.5, 0.0], [1.0, -2.0, 0.0], [3.0, -2.5, 0.0]],
+    [[-2.0, -1.5, 0.0], [0.0, 1.5, 0.0], [1.5, -1.5, 0.0], [3.5, 1.0, 0.0]],
+    [[3.0, 3.0, 0.0], [1.0, 3.5, 0.0], [-1.0, 3.0, 0.0], [-3.0, 3.5, 0.0]],
+]
+_counter = itertools.count(1)
+
+
+def flat(points):
+    """Return points (r, 3) as the flat list of the obstacles parameter."""
+    return [float(v) for point in points for v in point]
+
+
+def pose_array(points, frame_id='map', orientations=None):
+    """Return a geometry_msgs/PoseArray of points (k, 3), optional quaternions (k, 4)."""
+    from geometry_msgs.msg import Pose
+    from geometry_msgs.msg import PoseArray
+    msg = PoseArray()
+    msg.header.frame_id = frame_id
+    for i, point in enumerate(points):
+        pose = Pose()
+        pose.position.x, pose.position.y, pose.position.z = (float(v) for v in point)
+        if orientations is not None:
+            q = orientations[i]
+            pose.orientation.x, pose.orientation.y = float(q[0]), float(q[1])
+            pose.orientation.z, pose.orientation.w = float(q[2]), float(q[3])
+        msg.poses.append(pose)
+    return msg
+
+
+def make_request(configurations=CONFIGURATIONS, frame_id='map', **fields):
+    """Return a PlanSequence request through configurations (each (k, 3))."""
+    from punctured_planner_interfaces.srv import PlanSequence
+    request = PlanSequence.Request()
+    request.configurations = [pose_array(c, frame_id) for c in configurations]
+    for name, value in fields.items():
+        setattr(request, name, value)
+    return request
+
+
+def unique_namespace(tag='inproc'):
+    """Return a namespace no other test (or test run) uses."""
+    return '/pp_%s_%d_%d' % (tag, os.getpid(), next(_counter))
+
+
+class InProcessPlanner:
+    """A PlannerNode in its own Context, spun by a MultiThreadedExecutor in a thread."""
+
+    def __init__(self, namespace=None, **parameters):
+        """Start the node with parameter overrides (name=value)."""
+        import rclpy
+        from rclpy.executors import MultiThreadedExecutor
+        from rclpy.parameter import Parameter
+
+        from punctured_planner.planner_node import PlannerNode
+        self.namespace = namespace or unique_namespace()
+        self.context = rclpy.context.Context()
+        rclpy.init(context=self.context, args=[])
+        overrides = [Parameter(name, value=value) for name, value in parameters.items()]
+        self.node = PlannerNode(context=self.context, namespace=self.namespace,
+                                parameter_overrides=overrides)
+        self.executor = MultiThreadedExecutor(num_threads=4, context=self.context)
+        self.executor.add_node(self.node)
+        self.thread = threading.Thread(target=self.executor.spin, daemon=True)
+        self.thread.start()
+
+    def name(self, relative):
+        """Return the absolute name of one of the node's topics or services."""
+        return '%s/%s' % (self.namespace, relative)
+
+    def set(self, **parameters):
+        """Set parameters through the node's callbacks; return the SetParametersResults."""
+        from rclpy.parameter import Parameter
+        return self.node.set_parameters([Parameter(name, value=value)
+                                         for name, value in parameters.items()])
+
+    def close(self):
+        """Stop the executor thread, destroy the node, shut the Context down."""
+        import rclpy
+        self.executor.shutdown()
+        self.thread.join(timeout=10)
+        self.node.destroy_node()
+        rclpy.try_shutdown(context=self.context)
+
+
+class Latest:
+    """Keep the last message of a transient-local subscription (latched topics)."""
+
+    def __init__(self, node, msg_type, topic):
+        """Subscribe to topic with the node's latched QoS."""
+        from punctured_planner.planner_node import LATCHED
+        self.messages = []
+        self.subscription = node.create_subscription(msg_type, topic, self.messages.append,
+                                                     LATCHED)
+
+    @property
+    def last(self):
+        """Return the last message received, or None."""
+        return self.messages[-1] if self.messages else None
+
+
+def wait_for(predicate, timeout_sec=10.0, what='condition'):
+    """Poll predicate (no spinning) until it is true; fail the test after timeout."""
+    deadline = time.monotonic() + timeout_sec
+    while not predicate():
+        if time.monotonic() > deadline:
+            pytest.fail('timed out waiting for %s' % what)
+        time.sleep(0.01)
+
+
+def path_array(path):
+    """Return (positions (M, 3), stamps_ns (M,)) of a nav_msgs/Path."""
+    from punctured_planner.conversions import path_positions
+    from punctured_planner.conversions import path_stamps_ns
+    return path_positions(path), path_stamps_ns(path)
+
+
+def core_plan(configurations=CONFIGURATIONS, obstacles=OBSTACLES, dimension=2, **options):
+    """Return the core's plan for the same input the node gets (spread by default)."""
+    from punctured_planner.core import plan
+    from punctured_planner.core import Workspace
+    options.setdefault('variant', 'spread')
+    workspace = Workspace(np.asarray(obstacles, dtype=float)[:, :dimension].reshape(
+        -1, dimension), dimension=dimension, **options)
+    return plan(workspace, np.asarray(configurations, dtype=float)[..., :dimension])

@@ -1,0 +1,418 @@
+"""
+The planner node over real DDS: in process (its own Context and executor thread).
+
+Topics in (obstacles, robot_states, odometry), the PlanSequence service, each
+robot's Path, the domain index and the markers out; every error code; parameter
+changes. The client is the ``ros_client`` fixture (another Context).
+"""
+
+import math
+import time
+
+from conftest import RosClient
+import numpy as np
+from planner_helpers import CONFIGURATIONS
+from planner_helpers import core_plan
+from planner_helpers import flat
+from planner_helpers import InProcessPlanner
+from planner_helpers import Latest
+from planner_helpers import make_request
+from planner_helpers import OBSTACLES
+from planner_helpers import path_array
+from planner_helpers import pose_array
+import pytest
+
+pytestmark = pytest.mark.ros
+
+
+def _types():
+    from geometry_msgs.msg import PoseArray
+    from nav_msgs.msg import Odometry
+    from nav_msgs.msg import Path
+    from punctured_planner_interfaces.srv import PlanSequence
+    from std_msgs.msg import UInt32
+    from visualization_msgs.msg import MarkerArray
+    return PlanSequence, PoseArray, Path, UInt32, MarkerArray, Odometry
+
+
+@pytest.fixture
+def planner():
+    """Return a function starting in-process planner nodes; all closed after the test."""
+    started = []
+
+    def start(**parameters):
+        node = InProcessPlanner(**parameters)
+        started.append(node)
+        return node
+
+    yield start
+    for node in started:
+        node.close()
+
+
+def service_client(ros_client, node):
+    """Return a PlanSequence client of node, once the service is discovered."""
+    plan_sequence = _types()[0]
+    client = ros_client.node.create_client(plan_sequence, node.name('plan_sequence'))
+    ros_client.wait_for_service(client)
+    return client
+
+
+def test_topics_in_one_path_per_robot_out(planner, ros_client):
+    """Obstacles and robot state from topics; each robot's Path matches the core's plan."""
+    plan_sequence, pose_array_type, path_type, uint32, marker_array, _ = _types()
+    from punctured_planner.planner_node import LATCHED
+    node = planner(robot_count=4)
+    names = ['robot_%d' % i for i in range(4)]
+    paths = {name: Latest(ros_client.node, path_type, node.name(name + '/plan'))
+             for name in names}
+    domain = Latest(ros_client.node, uint32, node.name('domain_index'))
+    markers = Latest(ros_client.node, marker_array, node.name('plan_markers'))
+    obstacles = ros_client.node.create_publisher(pose_array_type, node.name('obstacles'),
+                                                 LATCHED)
+    obstacles.publish(pose_array(OBSTACLES))
+    states = ros_client.node.create_publisher(pose_array_type, node.name('robot_states'), 10)
+    client = service_client(ros_client, node)
+
+    assert ros_client.spin_until(
+        lambda: node.node.snapshot().obstacles.source.endswith('/obstacles'), 10)
+
+    def state_seen():
+        states.publish(pose_array(CONFIGURATIONS[0]))
+        return node.node.snapshot().state is not None
+
+    assert ros_client.spin_until(state_seen, 10), 'robot_states never arrived'
+    assert node.node.snapshot().state.source == 'robot_states'
+
+    before = time.time_ns()
+    request = make_request(CONFIGURATIONS[1:], use_current_state=True, max_speed=0.5)
+    response = ros_client.call(client, request)
+    assert response.error_code == plan_sequence.Response.NONE, response.error_msg
+    expected = core_plan()
+    assert response.domain_index == expected.domain_index
+    assert response.domain_count == expected.domain_count == 13
+    assert response.sequential_complexity == expected.sequential_complexity
+    assert response.optimal is True
+    assert list(response.projection_counts) == expected.projection_counts.tolist()
+    assert response.min_clearance == expected.min_clearance
+    assert response.duration.sec + response.duration.nanosec * 1e-9 == pytest.approx(
+        expected.duration(0.5), abs=1e-9)
+    assert len(response.paths) == 4
+
+    assert ros_client.spin_until(
+        lambda: all(s.last is not None for s in paths.values()) and domain.last is not None
+        and markers.last is not None, 10), 'plan topics not received'
+    first_stamps = None
+    for i, name in enumerate(names):
+        path = paths[name].last
+        assert path == response.paths[i]
+        assert path.header.frame_id == 'map'
+        positions, stamps = path_array(path)
+        # every breakpoint is a pose, exactly; z back on the plane
+        assert np.array_equal(positions[:, :2], expected.positions[:, i])
+        assert np.all(positions[:, 2] == 0.0)
+        if first_stamps is None:
+            first_stamps = stamps
+        assert np.array_equal(stamps, first_stamps), 'robots must share their stamps'
+    assert first_stamps[0] >= before
+    assert np.allclose(first_stamps - first_stamps[0], expected.stamps(0.5) * 1e9, atol=2)
+    assert domain.last.data == expected.domain_index
+    namespaces = {}
+    for marker in markers.last.markers:
+        namespaces.setdefault(marker.ns, []).append(marker)
+    assert len(namespaces['paths']) == 4 and len(namespaces['waypoints']) == 3
+    assert len(namespaces['obstacles'][0].points) == 3
+    assert 'lanes' in namespaces and 'axis' in namespaces
+
+    # a late subscriber still gets the latched plan
+    late = Latest(ros_client.node, path_type, node.name('robot_2/plan'))
+    late_domain = Latest(ros_client.node, uint32, node.name('domain_index'))
+    assert ros_client.spin_until(lambda: late.last is not None
+                                 and late_domain.last is not None, 10)
+    assert late.last == response.paths[2]
+    assert late_domain.last.data == expected.domain_index
+
+
+def test_every_error_code_and_the_node_keeps_serving(planner, ros_client, monkeypatch):
+    """Each code provoked at least once (priority too); a valid request succeeds after each."""
+    plan_sequence, _, path_type, uint32, _, _ = _types()
+    codes = plan_sequence.Response
+    node = planner(obstacles=flat(OBSTACLES))
+    domain = Latest(ros_client.node, uint32, node.name('domain_index'))
+    first_path = Latest(ros_client.node, path_type, node.name('robot_0/plan'))
+    client = service_client(ros_client, node)
+    seen = set()
+    c1, c2, c3 = (np.array(c) for c in CONFIGURATIONS)
+
+    def expect(request, code, *words):
+        response = ros_client.call(client, request)
+        assert response.error_code == code, (response.error_code, response.error_msg)
+        assert response.error_msg
+        for word in words:
+            assert word in response.error_msg, response.error_msg
+        assert len(response.paths) == 0 and response.domain_count == 0
+        seen.add(code)
+        return response
+
+    def valid():
+        response = ros_client.call(client, make_request())
+        assert response.error_code == codes.NONE, response.error_msg
+        return response
+
+    def moved(configuration, robot, point):
+        result = configuration.copy()
+        result[robot] = point
+        return result
+
+    expect(make_request([c1]), codes.NO_CONFIGURATIONS, 'at least 2')
+    expect(plan_sequence.Request(), codes.NO_CONFIGURATIONS)
+    expect(make_request([c2], use_current_state=True), codes.NO_ROBOT_STATE, 'robot_states')
+    expect(make_request(samples_per_leg=1001), codes.REQUEST_OVER_LIMITS, 'samples_per_leg')
+    expect(make_request(max_speed=math.nan), codes.INVALID_REQUEST, 'max_speed')
+    expect(make_request([np.zeros((0, 3)), c2]), codes.INVALID_REQUEST, 'no robots')
+    expect(make_request([c1, c2[:3]]), codes.ROBOT_COUNT_MISMATCH, 'configuration 1')
+    expect(make_request([c1, moved(c2, 2, [math.inf, 0, 0])]), codes.NON_FINITE_VALUE,
+           'configuration 1, robot 2')
+    expect(make_request(frame_id='odom'), codes.FRAME_MISMATCH, "'odom'")
+    expect(make_request([c1, moved(c2, 3, [3.5, 1.0, 0.25])]), codes.OFF_PLANE,
+           'configuration 1, robot 3')
+    expect(make_request([c1, moved(c2, 1, c2[0])]), codes.ROBOTS_COINCIDE,
+           'configuration 1', 'robots 0 and 1')
+    expect(make_request([c1, c2, moved(c3, 3, OBSTACLES[2])]), codes.ROBOT_ON_OBSTACLE,
+           'configuration 2', 'robot 3', 'obstacle 2')
+    # nothing is published for a refused request
+    ros_client.spin_until(lambda: False, 0.3)
+    assert domain.last is None and first_path.last is None
+
+    # priority: the smallest code wins
+    expect(make_request([c1, moved(c2, 0, [math.nan, 0, 0])], frame_id='odom'),
+           codes.NON_FINITE_VALUE)
+    expect(make_request([c1, moved(c2, 0, [1, 1, 5])], frame_id='odom'), codes.FRAME_MISMATCH)
+    expect(make_request([c1, c2[:3]], samples_per_leg=5000), codes.REQUEST_OVER_LIMITS)
+    expect(make_request([c1, np.zeros((0, 3)), c2[:3]]), codes.INVALID_REQUEST)
+    expect(make_request([c1, moved(c2, 1, c2[0])], frame_id='odom'), codes.FRAME_MISMATCH)
+    valid()
+    assert ros_client.spin_until(lambda: domain.last is not None, 10)
+
+    assert all(r.successful for r in node.set(max_robots=3))
+    expect(make_request(), codes.REQUEST_OVER_LIMITS, 'max_robots 3')
+    node.set(max_robots=10000, max_configurations=2)
+    expect(make_request(), codes.REQUEST_OVER_LIMITS, 'max_configurations 2')
+    node.set(max_configurations=1000, max_poses=50)
+    expect(make_request(), codes.REQUEST_OVER_LIMITS, 'max_poses 50')
+    node.set(max_poses=2000000)
+    valid()
+
+    node.set(robot_count=5)
+    expect(make_request(), codes.ROBOT_COUNT_MISMATCH, 'robot_count 5')
+    node.set(robot_count=0)
+    valid()
+
+    assert all(r.successful for r in node.set(obstacles=flat(OBSTACLES + OBSTACLES[:1])))
+    expect(make_request(), codes.OBSTACLES_DEGENERATE, 'obstacles 0 and 3')
+    node.set(obstacles=flat(OBSTACLES))
+    valid()
+
+    node.set(required_clearance=50.0)
+    refused = expect(make_request(), codes.CLEARANCE_BELOW_REQUIRED, 'required 50')
+    assert refused.min_clearance == core_plan().min_clearance > 0
+    node.set(required_clearance=0.0)
+    valid()
+
+    import punctured_planner.planning as planning
+
+    def broken(*args, **kwargs):
+        raise RuntimeError('injected fault')
+    monkeypatch.setattr(planning, 'core_plan', broken)
+    expect(make_request(), codes.UNKNOWN, 'injected fault')
+    monkeypatch.undo()
+    valid()
+
+    documented = {v for k, v in vars(codes).items() if k.isupper() and isinstance(v, int)}
+    assert seen == documented - {codes.NONE}
+
+
+def test_parameter_changes_take_effect_and_bad_values_are_refused(planner, ros_client):
+    """Variant, samples, speed, frame, dimension, names: the next plan follows them."""
+    plan_sequence, _, path_type, _, _, _ = _types()
+    node = planner(obstacles=flat(OBSTACLES))
+    client = service_client(ros_client, node)
+
+    def call(request=None):
+        response = ros_client.call(client, request or make_request())
+        assert response.error_code == plan_sequence.Response.NONE, response.error_msg
+        return response
+
+    assert len(call().paths[0].poses) == 2 * 9 + 1  # spread: 9 legs per segment
+    assert all(r.successful for r in node.set(variant='paper'))
+    response = call()
+    paper = core_plan(variant='paper')
+    assert np.array_equal(path_array(response.paths[1])[0][:, :2], paper.positions[:, 1])
+    node.set(samples_per_leg=2)
+    assert len(call().paths[0].poses) == 2 * 7 * 3 + 1
+    assert len(call(make_request(samples_per_leg=0)).paths[0].poses) == 2 * 7 + 1
+    node.set(max_speed=2.0, samples_per_leg=0)
+    response = call()
+    assert response.duration.sec + response.duration.nanosec * 1e-9 == pytest.approx(
+        paper.duration(2.0), abs=1e-9)
+    node.set(lane_spacing=2.5)
+    assert call().min_clearance == core_plan(variant='paper', lane_spacing=2.5).min_clearance
+
+    node.set(frame_id='world')
+    assert call(make_request(frame_id='')).paths[0].header.frame_id == 'world'
+    assert ros_client.call(client, make_request()).error_code == \
+        plan_sequence.Response.FRAME_MISMATCH
+    node.set(frame_id='map', dimension=3)
+    lifted = np.array(CONFIGURATIONS)
+    lifted[1, :, 2] = [0.5, -0.5, 1.0, 2.0]
+    positions = path_array(call(make_request(lifted)).paths[3])[0]
+    assert np.array_equal(positions, core_plan(lifted, variant='paper', lane_spacing=2.5,
+                                               dimension=3).positions[:, 3])
+    node.set(dimension=2, plane_z=1.5)
+    assert ros_client.call(client, make_request()).error_code == \
+        plan_sequence.Response.OFF_PLANE  # the obstacles (z = 0) are off the plane too
+    node.set(plane_z=0.0)
+
+    old_path = Latest(ros_client.node, path_type, node.name('robot_3/plan'))
+    assert ros_client.spin_until(lambda: old_path.last is not None, 10)
+    assert all(r.successful for r in node.set(robot_names=['a', 'b', 'c', 'd']))
+    named = Latest(ros_client.node, path_type, node.name('c/plan'))
+    response = call()
+    assert ros_client.spin_until(lambda: named.last is not None and len(old_path.messages) > 1,
+                                 10)
+    assert named.last == response.paths[2]
+    assert len(old_path.last.poses) == 0, 'a robot no longer planned gets an empty path'
+    assert ros_client.call(client, make_request(np.array(CONFIGURATIONS)[:, :3])).error_code \
+        == plan_sequence.Response.ROBOT_COUNT_MISMATCH
+
+    refused = {
+        'dimension': 4, 'variant': 'fast', 'lane_spacing': -1.0, 'min_spacing': math.nan,
+        'max_speed': 'quick', 'obstacles': [1.0, 2.0], 'robot_names': ['a', 'a'],
+        'robot_count': 3, 'frame_id': '', 'plane_z': math.inf, 'samples_per_leg': -1,
+        'required_clearance': -0.5, 'max_robots': 2,
+    }
+    for name, value in refused.items():
+        before = node.node.get_parameter(name).value
+        results = node.set(**{name: value})
+        assert not results[0].successful, (name, value)
+        assert results[0].reason, name
+        assert node.node.get_parameter(name).value == before, name
+    # names that are not ROS names
+    assert not node.set(robot_names=['1a', 'b', 'c', 'd'])[0].successful
+    assert node.node.snapshot().settings.robot_names == ('a', 'b', 'c', 'd')
+    call()
+
+
+def test_parameters_over_the_parameter_service(planner, ros_client):
+    """A remote parameter client (what `ros2 param set` uses) sees the same validation."""
+    from rclpy.parameter import Parameter
+    from rclpy.parameter_client import AsyncParameterClient
+    node = planner()
+    remote = AsyncParameterClient(ros_client.node, node.name('planner_node'))
+    assert remote.wait_for_services(timeout_sec=20)
+
+    def result(future):
+        assert ros_client.spin_until(future.done, 20)
+        return future.result()
+
+    answer = result(remote.set_parameters([Parameter('variant', value='paper'),
+                                           Parameter('dimension', value=7)]))
+    assert answer.results[0].successful and not answer.results[1].successful
+    values = result(remote.get_parameters(['variant', 'dimension'])).values
+    assert values[0].string_value == 'paper' and values[1].integer_value == 2
+    described = result(remote.describe_parameters(['lane_spacing', 'dimension'])).descriptors
+    assert described[0].description and described[0].floating_point_range
+    assert described[1].integer_range[0].to_value == 3
+
+
+def test_odometry_assembles_the_current_state(planner, ros_client):
+    """With robot_names, each <name>/odom feeds the current state (frame checked)."""
+    plan_sequence, _, _, _, _, odometry = _types()
+    names = ['r0', 'r1', 'r2', 'r3']
+    node = planner(obstacles=flat(OBSTACLES), robot_names=names)
+    publishers = [ros_client.node.create_publisher(odometry, node.name(n + '/odom'), 10)
+                  for n in names]
+    client = service_client(ros_client, node)
+    yaw = [0.0, 0.0, 0.3826834323650898, 0.9238795325112867]  # 45 degrees about z
+
+    def publish(frame='map'):
+        for i, publisher in enumerate(publishers):
+            msg = odometry()
+            msg.header.frame_id = frame if i == 2 else 'map'
+            msg.header.stamp.sec = 100 + i
+            x, y, z = CONFIGURATIONS[0][i]
+            msg.pose.pose.position.x, msg.pose.pose.position.y = x, y
+            (msg.pose.pose.orientation.x, msg.pose.pose.orientation.y,
+             msg.pose.pose.orientation.z, msg.pose.pose.orientation.w) = yaw
+            publisher.publish(msg)
+
+    def complete():
+        publish()
+        state = node.node.snapshot().state
+        return state is not None and len(state.positions) == 4
+
+    assert ros_client.spin_until(complete, 10), 'odometry never assembled'
+    state = node.node.snapshot().state
+    assert state.source.startswith('odometry') and state.stamp_ns == 100 * 10 ** 9
+    response = ros_client.call(client, make_request(CONFIGURATIONS[1:],
+                                                    use_current_state=True))
+    assert response.error_code == plan_sequence.Response.NONE, response.error_msg
+    assert list(response.projection_counts) == core_plan().projection_counts.tolist()
+    start = response.paths[2].poses[0].pose
+    assert (start.position.x, start.position.y) == tuple(CONFIGURATIONS[0][2][:2])
+    assert start.orientation.z == pytest.approx(yaw[2]) and start.orientation.w == \
+        pytest.approx(yaw[3])
+
+    def odom_frame():
+        publish(frame='odom')
+        return node.node.snapshot().state.frame_id == 'odom'
+
+    assert ros_client.spin_until(odom_frame, 10)
+    response = ros_client.call(client, make_request(CONFIGURATIONS[1:],
+                                                    use_current_state=True))
+    assert response.error_code == plan_sequence.Response.FRAME_MISMATCH
+    assert 'current robot state' in response.error_msg
+
+
+def test_planning_does_not_block_the_subscriptions(planner, ros_client):
+    """While a long plan runs in the service callback, robot_states still come in."""
+    plan_sequence, pose_array_type, _, _, _, _ = _types()
+    node = planner(max_poses=100000000)
+    states = ros_client.node.create_publisher(pose_array_type, node.name('robot_states'), 10)
+    client = service_client(ros_client, node)
+    rng = np.random.default_rng(7)
+    big = np.concatenate([rng.uniform(-50, 50, size=(3, 200, 2)), np.zeros((3, 200, 1))],
+                         axis=2)
+    def state_seen():
+        states.publish(pose_array(CONFIGURATIONS[2]))
+        return node.node.snapshot().state is not None
+
+    assert ros_client.spin_until(state_seen, 10)
+    future = client.call_async(make_request(big, samples_per_leg=10))  # 39,800 poses
+    received = [CONFIGURATIONS[2][0][0]]
+    deadline = time.monotonic() + 60
+    while not future.done() and time.monotonic() < deadline:
+        states.publish(pose_array(CONFIGURATIONS[len(received) % 3]))
+        ros_client.executor.spin_once(timeout_sec=0.02)
+        state = node.node.snapshot().state
+        if state is not None and (not received or state.positions[0, 0]
+                                  != received[-1]):
+            received.append(state.positions[0, 0])
+    assert future.done(), 'the large plan did not finish within 60 s'
+    assert future.result().error_code == plan_sequence.Response.NONE
+    assert len(received) >= 3, 'robot_states were not processed while planning'
+
+
+def test_a_second_client_context_gets_the_same_latched_plan(planner, ros_client):
+    """Another process-like client (own Context) joining later sees the last plan."""
+    plan_sequence, _, path_type, _, _, _ = _types()
+    node = planner(obstacles=flat(OBSTACLES))
+    response = ros_client.call(service_client(ros_client, node), make_request())
+    assert response.error_code == plan_sequence.Response.NONE
+    other = RosClient('late_client')
+    try:
+        late = Latest(other.node, path_type, node.name('robot_1/plan'))
+        assert other.spin_until(lambda: late.last is not None, 10)
+        assert late.last == response.paths[1]
+    finally:
+        other.close()
