@@ -86,7 +86,7 @@ class InProcessPlanner:
         """Return the absolute name of one of the node's topics or services."""
         return '%s/%s' % (self.namespace, relative)
 
-    def set(self, **parameters):
+    def set_parameters(self, **parameters):
         """Set parameters through the node's callbacks; return the SetParametersResults."""
         from rclpy.parameter import Parameter
         return self.node.set_parameters([Parameter(name, value=value)

@@ -194,29 +194,29 @@ def test_every_error_code_and_the_node_keeps_serving(planner, ros_client, monkey
     valid()
     assert ros_client.spin_until(lambda: domain.last is not None, 10)
 
-    assert all(r.successful for r in node.set(max_robots=3))
+    assert all(r.successful for r in node.set_parameters(max_robots=3))
     expect(make_request(), codes.REQUEST_OVER_LIMITS, 'max_robots 3')
-    node.set(max_robots=10000, max_configurations=2)
+    node.set_parameters(max_robots=10000, max_configurations=2)
     expect(make_request(), codes.REQUEST_OVER_LIMITS, 'max_configurations 2')
-    node.set(max_configurations=1000, max_poses=50)
+    node.set_parameters(max_configurations=1000, max_poses=50)
     expect(make_request(), codes.REQUEST_OVER_LIMITS, 'max_poses 50')
-    node.set(max_poses=2000000)
+    node.set_parameters(max_poses=2000000)
     valid()
 
-    node.set(robot_count=5)
+    node.set_parameters(robot_count=5)
     expect(make_request(), codes.ROBOT_COUNT_MISMATCH, 'robot_count 5')
-    node.set(robot_count=0)
+    node.set_parameters(robot_count=0)
     valid()
 
-    assert all(r.successful for r in node.set(obstacles=flat(OBSTACLES + OBSTACLES[:1])))
+    assert all(r.successful for r in node.set_parameters(obstacles=flat(OBSTACLES + OBSTACLES[:1])))
     expect(make_request(), codes.OBSTACLES_DEGENERATE, 'obstacles 0 and 3')
-    node.set(obstacles=flat(OBSTACLES))
+    node.set_parameters(obstacles=flat(OBSTACLES))
     valid()
 
-    node.set(required_clearance=50.0)
+    node.set_parameters(required_clearance=50.0)
     refused = expect(make_request(), codes.CLEARANCE_BELOW_REQUIRED, 'required 50')
     assert refused.min_clearance == core_plan().min_clearance > 0
-    node.set(required_clearance=0.0)
+    node.set_parameters(required_clearance=0.0)
     valid()
 
     import punctured_planner.planning as planning
@@ -244,38 +244,38 @@ def test_parameter_changes_take_effect_and_bad_values_are_refused(planner, ros_c
         return response
 
     assert len(call().paths[0].poses) == 2 * 9 + 1  # spread: 9 legs per segment
-    assert all(r.successful for r in node.set(variant='paper'))
+    assert all(r.successful for r in node.set_parameters(variant='paper'))
     response = call()
     paper = core_plan(variant='paper')
     assert np.array_equal(path_array(response.paths[1])[0][:, :2], paper.positions[:, 1])
-    node.set(samples_per_leg=2)
+    node.set_parameters(samples_per_leg=2)
     assert len(call().paths[0].poses) == 2 * 7 * 3 + 1
     assert len(call(make_request(samples_per_leg=0)).paths[0].poses) == 2 * 7 + 1
-    node.set(max_speed=2.0, samples_per_leg=0)
+    node.set_parameters(max_speed=2.0, samples_per_leg=0)
     response = call()
     assert response.duration.sec + response.duration.nanosec * 1e-9 == pytest.approx(
         paper.duration(2.0), abs=1e-9)
-    node.set(lane_spacing=2.5)
+    node.set_parameters(lane_spacing=2.5)
     assert call().min_clearance == core_plan(variant='paper', lane_spacing=2.5).min_clearance
 
-    node.set(frame_id='world')
+    node.set_parameters(frame_id='world')
     assert call(make_request(frame_id='')).paths[0].header.frame_id == 'world'
     assert ros_client.call(client, make_request()).error_code == \
         plan_sequence.Response.FRAME_MISMATCH
-    node.set(frame_id='map', dimension=3)
+    node.set_parameters(frame_id='map', dimension=3)
     lifted = np.array(CONFIGURATIONS)
     lifted[1, :, 2] = [0.5, -0.5, 1.0, 2.0]
     positions = path_array(call(make_request(lifted)).paths[3])[0]
     assert np.array_equal(positions, core_plan(lifted, variant='paper', lane_spacing=2.5,
                                                dimension=3).positions[:, 3])
-    node.set(dimension=2, plane_z=1.5)
+    node.set_parameters(dimension=2, plane_z=1.5)
     assert ros_client.call(client, make_request()).error_code == \
         plan_sequence.Response.OFF_PLANE  # the obstacles (z = 0) are off the plane too
-    node.set(plane_z=0.0)
+    node.set_parameters(plane_z=0.0)
 
     old_path = Latest(ros_client.node, path_type, node.name('robot_3/plan'))
     assert ros_client.spin_until(lambda: old_path.last is not None, 10)
-    assert all(r.successful for r in node.set(robot_names=['a', 'b', 'c', 'd']))
+    assert all(r.successful for r in node.set_parameters(robot_names=['a', 'b', 'c', 'd']))
     named = Latest(ros_client.node, path_type, node.name('c/plan'))
     response = call()
     assert ros_client.spin_until(lambda: named.last is not None and len(old_path.messages) > 1,
@@ -293,12 +293,12 @@ def test_parameter_changes_take_effect_and_bad_values_are_refused(planner, ros_c
     }
     for name, value in refused.items():
         before = node.node.get_parameter(name).value
-        results = node.set(**{name: value})
+        results = node.set_parameters(**{name: value})
         assert not results[0].successful, (name, value)
         assert results[0].reason, name
         assert node.node.get_parameter(name).value == before, name
     # names that are not ROS names
-    assert not node.set(robot_names=['1a', 'b', 'c', 'd'])[0].successful
+    assert not node.set_parameters(robot_names=['1a', 'b', 'c', 'd'])[0].successful
     assert node.node.snapshot().settings.robot_names == ('a', 'b', 'c', 'd')
     call()
 
@@ -383,6 +383,7 @@ def test_planning_does_not_block_the_subscriptions(planner, ros_client):
     rng = np.random.default_rng(7)
     big = np.concatenate([rng.uniform(-50, 50, size=(3, 200, 2)), np.zeros((3, 200, 1))],
                          axis=2)
+
     def state_seen():
         states.publish(pose_array(CONFIGURATIONS[2]))
         return node.node.snapshot().state is not None
