@@ -208,7 +208,8 @@ def test_every_error_code_and_the_node_keeps_serving(planner, ros_client, monkey
     node.set_parameters(robot_count=0)
     valid()
 
-    assert all(r.successful for r in node.set_parameters(obstacles=flat(OBSTACLES + OBSTACLES[:1])))
+    assert all(r.successful
+               for r in node.set_parameters(obstacles=flat(OBSTACLES + OBSTACLES[:1])))
     expect(make_request(), codes.OBSTACLES_DEGENERATE, 'obstacles 0 and 3')
     node.set_parameters(obstacles=flat(OBSTACLES))
     valid()
