@@ -1,0 +1,117 @@
+"""
+``punctured-planner plan``: offline planning, pictures and the MCAP recording.
+
+No ROS graph: the node's checks and conversions with a parameter file.
+"""
+
+import os
+import subprocess
+
+from conftest import REPO_ROOT
+from conftest import venv_script
+import numpy as np
+from planner_helpers import core_plan
+from punctured_planner.cli import main
+import pytest
+import yaml
+
+SCENARIO = os.path.join(REPO_ROOT, 'config', 'default_scenario.yaml')
+EXAMPLE = os.path.join(REPO_ROOT, 'config', 'example_request.yaml')
+
+
+def run(capsys, *argv):
+    """Run punctured-planner in process; return (exit code, parsed YAML, stderr)."""
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, yaml.safe_load(out) if out.strip() else None, err
+
+
+def test_plan_prints_the_same_answer_as_the_node(capsys):
+    code, data, err = run(capsys, 'plan', EXAMPLE, '--params', SCENARIO)
+    assert code == 0, err
+    expected = core_plan()
+    assert data['error_code'] == 0 and data['error_msg'] == ''
+    assert data['domain_index'] == expected.domain_index
+    assert data['projection_counts'] == expected.projection_counts.tolist()
+    assert len(data['paths']) == 4
+    positions = [[p['pose']['position'][a] for a in 'xy'] for p in data['paths'][1]['poses']]
+    assert np.array_equal(positions, expected.positions[:, 1])
+
+
+def test_plan_refusals_and_exit_codes(capsys, tmp_path):
+    code, data, err = run(capsys, 'plan', EXAMPLE)  # built-in defaults: no obstacles
+    assert code == 0 and data['domain_count'] == 3 * (4 - 1) + 1
+    request = yaml.safe_load(open(EXAMPLE, encoding='utf-8'))
+    request['configurations'][1]['header']['frame_id'] = 'odom'
+    bad_frame = tmp_path / 'odom.yaml'
+    bad_frame.write_text(yaml.safe_dump(request), encoding='utf-8')
+    code, data, err = run(capsys, 'plan', str(bad_frame), '--params', SCENARIO, '--no-paths')
+    assert code == 1 and data['error_code'] == 7 and 'FRAME_MISMATCH' in err
+    state = tmp_path / 'state.yaml'
+    state.write_text(yaml.safe_dump({'configurations': request['configurations'][:1],
+                                     'use_current_state': True}), encoding='utf-8')
+    code, data, err = run(capsys, 'plan', str(state))
+    assert code == 1 and data['error_code'] == 2
+    params = tmp_path / 'bad.yaml'
+    params.write_text('planner_node:\n  ros__parameters:\n    variant: fast\n', encoding='utf-8')
+    code, data, err = run(capsys, 'plan', EXAMPLE, '--params', str(params))
+    assert code == 2 and 'variant' in err
+
+
+def test_plan_png_and_mcap_from_the_console_script(tmp_path, ros_env):
+    """The installed command writes a PNG and an MCAP whose Paths are the breakpoints."""
+    png, mcap = tmp_path / 'plan.png', tmp_path / 'plan.mcap'
+    result = subprocess.run(
+        [venv_script('punctured-planner'), 'plan', EXAMPLE, '--params', SCENARIO,
+         '--no-paths', '--png', str(png), '--mcap', str(mcap)],
+        env=ros_env, capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert png.read_bytes()[:8] == b'\x89PNG\r\n\x1a\n' and png.stat().st_size > 10000
+    check_recording(mcap, core_plan())
+
+
+def check_recording(path, expected):
+    """Read an MCAP back with the mcap reader; compare the Paths with the plan."""
+    from mcap.reader import make_reader
+    from mcap_ros2.decoder import DecoderFactory
+    from nav_msgs.msg import Path
+    from rclpy.serialization import deserialize_message
+
+    with open(path, 'rb') as stream:
+        reader = make_reader(stream, decoder_factories=[DecoderFactory()])
+        assert reader.get_header().profile == 'ros2'
+        decoded = list(reader.iter_decoded_messages())
+        stream.seek(0)
+        metadata = {m.name: m.metadata for m in make_reader(stream).iter_metadata()}
+    topics = [channel.topic for _, channel, _, _ in decoded]
+    robots = ['/robot_%d/plan' % i for i in range(expected.positions.shape[1])]
+    assert sorted(topics) == sorted(robots + ['/plan_markers', '/domain_index'])
+    for schema, channel, message, ros_msg in decoded:
+        assert schema.encoding == 'ros2msg' and channel.message_encoding == 'cdr'
+        if channel.topic in robots:
+            i = robots.index(channel.topic)
+            assert schema.name == 'nav_msgs/msg/Path'
+            assert 'MSG: geometry_msgs/msg/PoseStamped' in schema.data.decode()
+            positions = np.array([[p.pose.position.x, p.pose.position.y, p.pose.position.z]
+                                  for p in ros_msg.poses])
+            assert np.array_equal(positions[:, :2], expected.positions[:, i])
+            # the bytes are what the real type support reads
+            real = deserialize_message(message.data, Path)
+            assert len(real.poses) == len(positions) and real.header.frame_id == 'map'
+            stamps = [(p.header.stamp.sec, p.header.stamp.nanosec) for p in ros_msg.poses]
+            assert stamps == [(p.header.stamp.sec, p.header.stamp.nanosec)
+                              for p in real.poses]
+        elif channel.topic == '/domain_index':
+            assert ros_msg.data == expected.domain_index
+        else:
+            assert {m.ns for m in ros_msg.markers} >= {'obstacles', 'paths', 'waypoints'}
+    assert metadata['punctured_planner']['domain_index'] == str(expected.domain_index)
+
+
+@pytest.mark.parametrize('option', ['--gif'])
+def test_plan_gif(capsys, tmp_path, option):
+    out = tmp_path / 'plan.gif'
+    code, _, err = run(capsys, 'plan', EXAMPLE, '--params', SCENARIO, '--no-paths', option,
+                       str(out), '--gif-seconds', '1', '--gif-fps', '4', '--gif-dpi', '40')
+    assert code == 0, err
+    assert out.read_bytes()[:6] in (b'GIF89a', b'GIF87a')

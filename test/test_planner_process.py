@@ -1,0 +1,81 @@
+"""
+The installed planner_node across processes, and ``punctured-planner call`` against it.
+
+The node runs from its console script with the bundled default scenario; the
+client is rclpy in this process or the ``punctured-planner`` command.
+"""
+
+import os
+import subprocess
+
+from conftest import REPO_ROOT
+from conftest import venv_script
+import numpy as np
+from planner_helpers import core_plan
+from planner_helpers import Latest
+from planner_helpers import path_array
+import pytest
+import yaml
+
+SCENARIO = os.path.join(REPO_ROOT, 'config', 'default_scenario.yaml')
+EXAMPLE = os.path.join(REPO_ROOT, 'config', 'example_request.yaml')
+
+pytestmark = pytest.mark.ros
+
+
+def example_request():
+    """Return config/example_request.yaml as a PlanSequence request."""
+    from punctured_planner.msg_dict import fill_message
+    from punctured_planner_interfaces.srv import PlanSequence
+    with open(EXAMPLE, encoding='utf-8') as stream:
+        return fill_message(PlanSequence.Request(), yaml.safe_load(stream))
+
+
+def test_default_scenario_across_processes(planner_process, ros_client, ros_env):
+    """The node plans the example request at once; the CLI call succeeds too."""
+    from nav_msgs.msg import Path
+    from punctured_planner_interfaces.srv import PlanSequence
+    node = planner_process(params_file=SCENARIO)
+    client = ros_client.node.create_client(PlanSequence, node.name('plan_sequence'))
+    ros_client.wait_for_service(client)
+    latched = Latest(ros_client.node, Path, node.name('robot_3/plan'))
+
+    response = ros_client.call(client, example_request())
+    assert response.error_code == PlanSequence.Response.NONE, response.error_msg + node.log()
+    expected = core_plan()
+    assert response.domain_index == expected.domain_index
+    assert len(response.paths) == 4
+    for i, path in enumerate(response.paths):
+        assert np.array_equal(path_array(path)[0][:, :2], expected.positions[:, i])
+    # waypoint C_3 carries the request's orientation (yaw 90 degrees)
+    final = response.paths[0].poses[-1].pose.orientation
+    assert final.z == pytest.approx(0.7071067811865476) and final.w == pytest.approx(
+        0.7071067811865476)
+    assert ros_client.spin_until(lambda: latched.last is not None, 10)
+    assert latched.last == response.paths[3]
+
+    result = subprocess.run(
+        [venv_script('punctured-planner'), 'call', EXAMPLE,
+         '--service', node.name('plan_sequence'), '--wait', '20'],
+        env=ros_env, capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0, result.stderr + node.log()
+    data = yaml.safe_load(result.stdout)
+    assert data['error_code'] == 0 and data['domain_index'] == expected.domain_index
+    assert len(data['paths']) == 4
+
+    node.assert_running()
+    assert 'snapshot: 3 obstacles from the parameter' in node.log()
+    assert node.stop() == 0, node.log()
+
+
+@pytest.mark.parametrize('arguments', [('-p', 'dimension:=5'), ('-p', 'variant:=fast')],
+                         ids=['out-of-range', 'refused-by-validation'])
+def test_invalid_parameters_stop_the_node(planner_process, arguments):
+    """A bad parameter at start-up: exit code 2 and the reason, not a traceback."""
+    node = planner_process(*arguments)
+    try:
+        code = node.proc.wait(timeout=60)
+    except subprocess.TimeoutExpired:
+        pytest.fail('planner_node kept running with %s:\n%s' % (arguments, node.log()))
+    assert code == 2, node.log()
+    assert 'invalid parameters' in node.log()
