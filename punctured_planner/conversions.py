@@ -21,7 +21,18 @@ Conventions:
   as the identity; others are normalised.
 """
 
+from builtin_interfaces.msg import Duration
+from builtin_interfaces.msg import Time
+from geometry_msgs.msg import Point
+from geometry_msgs.msg import PoseStamped
+from geometry_msgs.msg import Vector3
+from nav_msgs.msg import Path
 import numpy as np
+from std_msgs.msg import ColorRGBA
+from std_msgs.msg import Header
+from std_msgs.msg import UInt32
+from visualization_msgs.msg import Marker
+from visualization_msgs.msg import MarkerArray
 
 IDENTITY = (0.0, 0.0, 0.0, 1.0)
 # Colours of the robots in the markers (RGB, matplotlib's tab10).
@@ -111,14 +122,12 @@ def normalized_quaternions(quaternions):
 
 def time_from_ns(ns):
     """Return builtin_interfaces/Time for integer nanoseconds (>= 0)."""
-    from builtin_interfaces.msg import Time
     ns = int(ns)
     return Time(sec=ns // 1000000000, nanosec=ns % 1000000000)
 
 
 def duration_from_seconds(seconds):
     """Return builtin_interfaces/Duration for a finite number of seconds (rounded to ns)."""
-    from builtin_interfaces.msg import Duration
     ns = int(round(float(seconds) * 1e9))
     return Duration(sec=ns // 1000000000, nanosec=ns % 1000000000)
 
@@ -155,10 +164,6 @@ def plan_to_paths(plan, orientations, frame_id, start_ns, max_speed, samples_per
     the stamp of the first pose. All paths share one Header object per stamp, so
     their stamps are identical by construction.
     """
-    from geometry_msgs.msg import PoseStamped
-    from nav_msgs.msg import Path
-    from std_msgs.msg import Header
-
     seconds, positions, waypoint = path_samples(plan, max_speed, samples_per_leg)
     xyz = to_xyz(positions, plane_z)
     quaternions = normalized_quaternions(orientations)
@@ -199,13 +204,11 @@ def path_stamps_ns(path):
 
 
 def _colour(index, alpha=1.0):
-    from std_msgs.msg import ColorRGBA
     r, g, b = PALETTE[index % len(PALETTE)]
     return ColorRGBA(r=r, g=g, b=b, a=alpha)
 
 
 def _points(xyz):
-    from geometry_msgs.msg import Point
     points = []
     for x, y, z in np.asarray(xyz, dtype=float).tolist():
         point = Point()
@@ -224,12 +227,6 @@ def plan_markers(plan, frame_id, stamp_ns, plane_z=0.0, names=None):
     every breakpoint, robot colours), ``waypoints`` (one SPHERE_LIST per
     configuration C_m) and ``labels`` (robot names at C_1).
     """
-    from geometry_msgs.msg import Vector3
-    from std_msgs.msg import ColorRGBA
-    from std_msgs.msg import Header
-    from visualization_msgs.msg import Marker
-    from visualization_msgs.msg import MarkerArray
-
     header = Header(frame_id=frame_id, stamp=time_from_ns(stamp_ns))
     positions = to_xyz(plan.positions, plane_z)
     k = positions.shape[1]
@@ -282,14 +279,11 @@ def plan_markers(plan, frame_id, stamp_ns, plane_z=0.0, names=None):
 
 def domain_index_message(plan):
     """Return the std_msgs/UInt32 domain index of a plan."""
-    from std_msgs.msg import UInt32
     return UInt32(data=int(plan.domain_index))
 
 
 def empty_path(frame_id, stamp_ns):
     """Return a nav_msgs/Path with no poses: 'no current plan' for a robot."""
-    from nav_msgs.msg import Path
-    from std_msgs.msg import Header
     return Path(header=Header(frame_id=frame_id, stamp=time_from_ns(stamp_ns)))
 
 
