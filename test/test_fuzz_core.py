@@ -5,7 +5,7 @@ Every call either raises PlanningError with a documented code, naming the
 configuration, robots and obstacle at fault, or returns a plan whose
 certificate is positive, above the numerical resolution, and agrees with an
 independent dense and exact check (test/motion_check.py): never a silent
-collision. About 2,500 requests in all (the ``max_examples`` below).
+collision. About 2,300 requests in all (the ``max_examples`` below).
 
 Guaranteed range (measured here, stated for msg_docs):
 
@@ -19,7 +19,7 @@ Guaranteed range (measured here, stated for msg_docs):
 * The certificate D agrees with the exact minimum over the float breakpoints
   within 1e-9 D + 8 u S (u = 1.1e-16): relative 1e-9 whenever D >= 1e-6 S; near
   the resolution limit the float64 rounding of the closed form dominates (seen
-  up to 2e-5 relative at S = 4e11, D = 1). Since D > 1e-12 S, the true minimum
+  up to 4e-5 relative at S = 3e11, D = 1). Since D > 1e-12 S, the true minimum
   is always at least D (1 - 1e-3) > 0.
 * Lane spacing and min_spacing >= 1e-100 (far below any node parameter). Below
   about 1e-150 squared distances become subnormal and the certificate loses
