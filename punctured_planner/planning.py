@@ -26,10 +26,13 @@ import numpy as np
 from . import conversions
 from .core import ErrorCode, plan as core_plan, PlanningError, Workspace
 from .core.sections import PAPER_LEGS, SPREAD_LEGS
+from .core.validation import MAX_COORDINATE
 from .parameters import MAX_SAMPLES_PER_LEG
 
 # Largest |z - plane_z| accepted in planar mode (m).
 PLANE_TOLERANCE = 1e-9
+# builtin_interfaces/Time holds int32 seconds: no stamp may reach 2^31 s.
+_LAST_STAMP_NS = (2 ** 31 - 1) * 1000000000
 _AXES = 'xyz'
 
 
@@ -45,7 +48,8 @@ class ObstacleSet:
     def describe(self):
         """Return a short text for the log: count, source and stamp."""
         if self.source == 'parameter':
-            return '%d obstacles from the parameter' % len(self.points)
+            return '%d obstacles from the parameter (set at %.9f)' % (
+                len(self.points), self.stamp_ns * 1e-9)
         return '%d obstacles from topic %s (stamp %.9f)' % (
             len(self.points), self.source, self.stamp_ns * 1e-9)
 
@@ -208,6 +212,9 @@ class Planner:
         for m, count in enumerate(counts):
             if count == 0:
                 _fail(ErrorCode.INVALID_REQUEST, '%s has no robots' % label(m), configuration=m)
+        arrays = ([state.positions] if state is not None else []) + [
+            conversions.pose_array_positions(c) for c in configurations]
+        self._check_range(settings, arrays, snapshot.obstacles, label)
         for m, count in enumerate(counts):
             if count != counts[0]:
                 _fail(ErrorCode.ROBOT_COUNT_MISMATCH, '%s has %d robots, %s has %d'
@@ -219,12 +226,12 @@ class Planner:
             _fail(ErrorCode.ROBOT_COUNT_MISMATCH, '%s has %d robots but the node is configured '
                   'for %s' % (label(0), counts[0], what), configuration=0)
 
-        positions, orientations = conversions.configurations_to_arrays(configurations)
-        frames = [c.header.frame_id for c in configurations]
-        if state is not None:
-            positions = np.concatenate([state.positions[None], positions])
-            orientations = np.concatenate([state.orientations[None], orientations])
-            frames.insert(0, state.frame_id)
+        positions = np.stack(arrays)
+        orientations = np.stack(
+            ([state.orientations] if state is not None else [])
+            + [conversions.pose_array_orientations(c) for c in configurations])
+        frames = ([state.frame_id] if state is not None else []) + [
+            c.header.frame_id for c in configurations]
         obstacles = snapshot.obstacles
         self._check_values(settings, positions, frames, obstacles, label)
 
@@ -235,6 +242,7 @@ class Planner:
         the_plan = core_plan(workspace, planar)
         planning_time = time.perf_counter() - started
         start_ns = int(now_ns) + int(round(planning_time * 1e9))
+        self._check_duration(the_plan, max_speed, start_ns)
         paths = conversions.plan_to_paths(the_plan, orientations, settings.frame_id, start_ns,
                                           max_speed, samples, settings.plane_z)
         conversions.fill_response(outcome.response, the_plan, paths, planning_time, max_speed)
@@ -274,6 +282,51 @@ class Planner:
             _fail(ErrorCode.REQUEST_OVER_LIMITS, 'the answer would hold %d poses (%d robots x '
                   '%d poses), more than max_poses %d' % (poses, k, poses // max(k, 1),
                                                          settings.max_poses))
+
+    @staticmethod
+    def _check_range(settings, arrays, obstacles, label):
+        """
+        INVALID_REQUEST for a finite coordinate beyond the core's range (+-1e15).
+
+        The core checks this too, but only after codes 5-8; here it keeps the
+        documented priority. Only the d coordinates the core plans in count (in
+        planar mode z has its own check, OFF_PLANE); non-finite values are
+        NON_FINITE_VALUE.
+        """
+        d = settings.dimension
+        for m, points in enumerate(arrays):
+            values = points[:, :d]
+            far = np.isfinite(values) & (np.abs(values) > MAX_COORDINATE)
+            if far.any():
+                robot, axis = (int(i) for i in np.argwhere(far)[0])
+                _fail(ErrorCode.INVALID_REQUEST, '%s, robot %d: %s = %.6g is beyond the '
+                      'supported range +-%.0e' % (label(m), robot, _AXES[axis],
+                                                  float(values[robot, axis]), MAX_COORDINATE),
+                      configuration=m, robots=[robot])
+        values = obstacles.points[:, :d]
+        far = np.isfinite(values) & (np.abs(values) > MAX_COORDINATE)
+        if far.any():
+            j, axis = (int(i) for i in np.argwhere(far)[0])
+            _fail(ErrorCode.INVALID_REQUEST, 'obstacle %d (%s): %s = %.6g is beyond the '
+                  'supported range +-%.0e' % (j, obstacles.source, _AXES[axis],
+                                              float(values[j, axis]), MAX_COORDINATE),
+                  obstacle=j)
+
+    @staticmethod
+    def _check_duration(the_plan, max_speed, start_ns):
+        """
+        INVALID_REQUEST when the motion's stamps do not fit builtin_interfaces/Time.
+
+        Time and Duration carry int32 seconds: the last stamp must come before
+        2038-01-19 and the duration must stay below 2^31 s. Known only once the
+        plan's length is, so checked after planning.
+        """
+        with np.errstate(over='ignore', divide='ignore', invalid='ignore'):
+            duration = the_plan.duration(max_speed)
+        if not (math.isfinite(duration) and start_ns + duration * 1e9 < _LAST_STAMP_NS):
+            _fail(ErrorCode.INVALID_REQUEST, 'the motion would last %.6g s at max_speed %.6g '
+                  'm/s: its stamps would pass the largest builtin_interfaces/Time '
+                  '(2038-01-19T03:14:07Z); raise max_speed' % (duration, max_speed))
 
     @staticmethod
     def _check_values(settings, positions, frames, obstacles, label):

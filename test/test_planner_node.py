@@ -191,6 +191,9 @@ def test_every_error_code_and_the_node_keeps_serving(planner, ros_client, monkey
     expect(make_request([c1, c2[:3]], samples_per_leg=5000), codes.REQUEST_OVER_LIMITS)
     expect(make_request([c1, np.zeros((0, 3)), c2[:3]]), codes.INVALID_REQUEST)
     expect(make_request([c1, moved(c2, 1, c2[0])], frame_id='odom'), codes.FRAME_MISMATCH)
+    expect(make_request([c1, moved(c2, 2, [1e300, 0, 0]), c3[:3]], frame_id='odom'),
+           codes.INVALID_REQUEST, 'configuration 1, robot 2', 'beyond')
+    expect(make_request(max_speed=1e-12), codes.INVALID_REQUEST, 'raise max_speed')
     valid()
     assert ros_client.spin_until(lambda: domain.last is not None, 10)
 

@@ -64,7 +64,7 @@ def test_default_scenario_across_processes(planner_process, ros_client, ros_env)
     assert len(data['paths']) == 4
 
     node.assert_running()
-    assert 'snapshot: 3 obstacles from the parameter' in node.log()
+    assert 'snapshot: 3 obstacles from the parameter (set at ' in node.log()
     assert node.stop() == 0, node.log()
 
 

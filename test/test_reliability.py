@@ -144,9 +144,8 @@ def documented_outcome(spec, state):
     Return ({code: configuration or None}, plan or None) that the documentation predicts.
 
     ROS-level checks first, in msg_docs/PlanSequence.md's priority order (the
-    smallest code wins), then the core's (codes 9-12 and the |x| > 1e15 range
-    check, INVALID_REQUEST). One known deviation is accepted here and pinned by
-    a strict xfail test below: the node runs the range check after codes 5-8.
+    smallest code wins; the |x| > 1e15 range check is INVALID_REQUEST, before
+    codes 5-8), then the core's (codes 9-12).
     """
     configurations = [np.asarray(points, dtype=float).reshape(-1, 3)
                       for _, points in spec['configurations']]
@@ -174,12 +173,11 @@ def documented_outcome(spec, state):
             return {CODE.INVALID_REQUEST: m}, None
     far = [m for m, c in enumerate(configurations)
            if np.any(np.abs(np.nan_to_num(c[:, :2], posinf=0, neginf=0)) > MAX_COORDINATE)]
+    if far:
+        return {CODE.INVALID_REQUEST: far[0]}, None
     fault = ros_fault(configurations, frames, counts)
     if fault is not None:
-        outcome = {fault[0]: fault[1]}
-        if far:
-            outcome[CODE.INVALID_REQUEST] = far[0]
-        return outcome, None
+        return {fault[0]: fault[1]}, None
     try:
         return {CODE.NONE: None}, plan(workspace(), np.stack(configurations)[..., :2])
     except PlanningError as error:
@@ -295,9 +293,9 @@ def assert_serves_a_valid_request(client, service_handle):
 
 # ---------------------------------------------------------------- 1. service fuzz
 
-# Not in these lists, pinned by strict xfail tests at the end instead (node bugs):
-# coordinates near 1e8 and beyond, and max_speed under about 1e-6 m/s, whose
-# motions last longer than the stamps can hold.
+# Not in these lists, tested at the end instead: coordinates near 1e8 and beyond,
+# and max_speed under about 1e-6 m/s, whose motions last longer than the stamps can
+# hold (refused with INVALID_REQUEST).
 GRID = st.integers(-8, 8).map(lambda v: v / 2)
 BAD_XY = (math.nan, math.inf, -math.inf, 1e300, -1e16, 2e15)
 Z_VALUES = (0.0, -0.0, 1e-10, 1e-9, 2e-9, 1.0, -1e300, math.nan)
@@ -724,19 +722,10 @@ def far(configurations, offset):
     return [[[x + offset, y + offset, z] for x, y, z in c] for c in configurations]
 
 
-LONG_MOTION_BUG = pytest.mark.xfail(
-    strict=True, reason='node bug: a motion longer than the stamps can hold (int64 ns, int32 '
-    's on the wire) is answered NONE with negative or decreasing stamps and a wrapped '
-    'duration; max_speed 5e-324 gives UNKNOWN (OverflowError in duration_from_seconds)')
-
-
 @pytest.mark.parametrize('spec', [
-    pytest.param(spec_of(CONFIGURATIONS, max_speed=5e-324), id='speed-5e-324',
-                 marks=LONG_MOTION_BUG),
-    pytest.param(spec_of(CONFIGURATIONS, max_speed=1e-9), id='speed-1e-9',
-                 marks=LONG_MOTION_BUG),
-    pytest.param(spec_of(far(CONFIGURATIONS, 1e8)), id='coordinates-1e8',
-                 marks=LONG_MOTION_BUG),
+    pytest.param(spec_of(CONFIGURATIONS, max_speed=5e-324), id='speed-5e-324'),
+    pytest.param(spec_of(CONFIGURATIONS, max_speed=1e-9), id='speed-1e-9'),
+    pytest.param(spec_of(far(CONFIGURATIONS, 1e8)), id='coordinates-1e8'),
     pytest.param(spec_of(far(CONFIGURATIONS, 1e9), max_speed=1e6), id='coordinates-1e9-fast'),
     pytest.param(spec_of(far(CONFIGURATIONS, 1e6)), id='coordinates-1e6'),
 ])
@@ -749,8 +738,6 @@ def test_long_motions_get_valid_stamps_or_a_documented_refusal(node, client, ser
         assert stamp_ns(response.duration) >= 0
 
 
-@pytest.mark.xfail(strict=True, reason='node/core bug: the |x| > 1e15 check (INVALID_REQUEST, '
-                   '4) runs after FRAME_MISMATCH (7), against the documented priority')
 def test_out_of_range_coordinates_take_priority_over_the_frame_check(node, client, service):
     """A coordinate beyond 1e15 in a request in the wrong frame: INVALID_REQUEST first."""
     configurations = [list(map(list, c)) for c in CONFIGURATIONS]
