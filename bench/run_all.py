@@ -78,7 +78,8 @@ def headline(figures, outcomes):
 
 def method_lines(settings, seconds):
     """Return the paragraph that says how the figures were measured."""
-    grid = ', '.join(f'{key} in {set(values)}' for key, values in settings.grid.items())
+    grid = '; '.join(f'{key} in {", ".join(map(str, values))}'
+                     for key, values in settings.grid.items())
     return [
         f'Queries: {grid}; {settings.seeds} seeds each, the same for every planner. '
         'random: every configuration uniform in a box; adversarial: robots sharing '
