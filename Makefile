@@ -40,7 +40,7 @@ STAMP_IFACE := $(STAMPS)/interfaces-$(IFACE_KEY)-$(WHEELS_KEY)
 STAMP_PROJECT := $(STAMPS)/project-$(PROJECT_KEY)-$(IFACE_KEY)-$(WHEELS_KEY)
 
 # Missing prerequisites stop the build with one line saying what to install.
-SETUP_GOALS := $(filter setup test run,$(MAKECMDGOALS))
+SETUP_GOALS := $(filter setup test run bench,$(MAKECMDGOALS))
 ifneq ($(filter lock,$(MAKECMDGOALS))$(if $(SETUP_GOALS),$(if $(wildcard $(VPY)),,x)),)
 ifeq ($(shell command -v $(PYTHON)),)
 $(error $(PYTHON) not found: install Python 3.11 (Debian 12: apt-get install python3.11 python3.11-venv))
@@ -71,12 +71,13 @@ PIP_INSTALL := $(PIP) install --progress-bar off --disable-pip-version-check -q
 # this machine's pip configuration names local index folders that may be empty
 PIP_FILTER := { grep -v -e 'is ignored: it is neither a file nor a directory' || true; }
 
-.PHONY: help setup test run lock clean
+.PHONY: help setup test run bench lock clean
 
 help:
 	@echo 'make run    start the planner node in the foreground (after setup)'
 	@echo 'make test   run the whole test suite: unit, lint, DDS, colcon (after setup)'
 	@echo 'make setup  create .venv, install pinned packages, build the interfaces'
+	@echo 'make bench  benchmarks beside OMPL (a few minutes): bench/results.md, results.png'
 	@echo 'make lock   re-resolve requirements.txt into constraints.txt'
 	@echo 'make clean  remove .venv and caches'
 
@@ -117,6 +118,11 @@ $(STAMP_PROJECT): | $(STAMP_IFACE)
 
 test: setup
 	$(VPY) -m pytest test/ $(PYTEST_ARGS)
+
+# Not part of make test: a few minutes, and OMPL only installed here.
+bench: setup
+	@$(PIP_INSTALL) -r bench/requirements.txt -c constraints.txt 2>&1 | $(PIP_FILTER)
+	$(VPY) bench/run_all.py $(BENCH_ARGS)
 
 # Discovery stays on this machine unless ROS_AUTOMATIC_DISCOVERY_RANGE says otherwise.
 run: setup
