@@ -24,9 +24,8 @@ import time
 import numpy as np
 
 from . import conversions
-from .core import ErrorCode, plan as core_plan, PlanningError, Workspace
-from .core.sections import PAPER_LEGS, SPREAD_LEGS
-from .core.validation import MAX_COORDINATE
+from .core import (ErrorCode, MAX_COORDINATE, PAPER_LEGS, plan as core_plan, PlanningError,
+                   SPREAD_LEGS, Workspace)
 from .parameters import MAX_SAMPLES_PER_LEG
 
 # Largest |z - plane_z| accepted in planar mode (m).

@@ -21,9 +21,9 @@ Guaranteed range (measured here, stated for msg_docs):
   the resolution limit the float64 rounding of the closed form dominates (seen
   up to 4e-5 relative at S = 3e11, D = 1). Since D > 1e-12 S, the true minimum
   is always at least D (1 - 1e-3) > 0.
-* Lane spacing and min_spacing >= 1e-100 (far below any node parameter). Below
-  about 1e-150 squared distances become subnormal and the certificate loses
-  accuracy (see the strict xfail test below).
+* Lane spacing and min_spacing >= 1e-100 (far below any node parameter); the
+  certificate rescales far-from-unit coordinates by a power of two, so even
+  lengths near 1e-160 are certified exactly (test_subnormal_scale_...).
 """
 
 from fractions import Fraction
@@ -162,7 +162,8 @@ def documented_faults(items, obstacles):
             break
     if faults:
         # A count mismatch hides later per-coordinate faults, except the range check.
-        far = [m for m, item in enumerate(items) if np.any(np.abs(item) > MAX_COORDINATE)]
+        far = [m for m, item in enumerate(items)
+               if np.any(np.isfinite(item) & (np.abs(item) > MAX_COORDINATE))]
         if far:
             faults.append((ErrorCode.INVALID_REQUEST, far[0], None))
         return sorted(faults)
@@ -256,12 +257,8 @@ def plan_or_refuse(ws, request, items):
             assert error.code == ErrorCode.CLEARANCE_BELOW_REQUIRED, str(error)
             assert_refusal_is_honest(ws, np.stack(items), error)
             return error
-        # Documented: the smallest code wins. Known deviation (strict xfail below):
-        # the core checks the range after the count and finiteness checks.
-        allowed = {faults[0][0]}
-        if faults[0][0] == ErrorCode.INVALID_REQUEST and len(faults) > 1:
-            allowed.add(faults[1][0])
-        assert error.code in allowed, (str(error), faults)
+        # Documented: the smallest code wins.
+        assert error.code == faults[0][0], (str(error), faults)
         expected = [f for f in faults if f[0] == error.code][0]
         assert error.configuration == expected[1], (str(error), faults)
         if expected[2] is not None:
@@ -463,9 +460,6 @@ def test_malformed_workspaces_raise_a_documented_code_naming_the_obstacle(case):
 
 # Known deviations, pinned so that a fix turns them into failures to remove here.
 
-@pytest.mark.xfail(strict=True, reason='core bug: the |x| > 1e15 check (INVALID_REQUEST, 4) '
-                   'runs after ROBOT_COUNT_MISMATCH (5) and NON_FINITE_VALUE (6), against '
-                   'the documented smallest-code-first priority')
 @pytest.mark.parametrize('request_', [
     [[[np.nan, 1.0]], [[1e300, 2.0]]],
     [[[1e300, 1.0]], [[0.5, 2.0], [3.0, 3.0]]],
@@ -477,19 +471,13 @@ def test_out_of_range_coordinates_take_priority_as_documented(request_):
     assert refused.value.code == ErrorCode.INVALID_REQUEST
 
 
-NON_NUMERIC_BUG = pytest.mark.xfail(
-    strict=True, reason='core bug: validation lets numpy raise a plain ValueError, '
-    'TypeError or OverflowError (no code), or drops the imaginary part of a complex value')
-
-
 @pytest.mark.parametrize('request_', [
-    pytest.param([[[0.5, 1.0], [2.0]], [[0.5, 2.0], [2.0, 1.0]]], id='ragged-point',
-                 marks=NON_NUMERIC_BUG),
-    pytest.param([[['a', 'b']], [['c', 'd']]], id='strings', marks=NON_NUMERIC_BUG),
-    pytest.param(None, id='none', marks=NON_NUMERIC_BUG),
-    pytest.param(5, id='scalar', marks=NON_NUMERIC_BUG),
-    pytest.param([[[10 ** 400, 1.0]], [[0.5, 2.0]]], id='huge-int', marks=NON_NUMERIC_BUG),
-    pytest.param([[[0.5 + 1j, 1.0]], [[0.5, 2.0]]], id='complex', marks=NON_NUMERIC_BUG),
+    pytest.param([[[0.5, 1.0], [2.0]], [[0.5, 2.0], [2.0, 1.0]]], id='ragged-point'),
+    pytest.param([[['a', 'b']], [['c', 'd']]], id='strings'),
+    pytest.param(None, id='none'),
+    pytest.param(5, id='scalar'),
+    pytest.param([[[10 ** 400, 1.0]], [[0.5, 2.0]]], id='huge-int'),
+    pytest.param([[[0.5 + 1j, 1.0]], [[0.5, 2.0]]], id='complex'),
     pytest.param([None, None], id='none-items'),
     pytest.param([[1.0, 2.0], [3.0, 4.0]], id='no-points'),
 ])
@@ -500,9 +488,6 @@ def test_non_numeric_requests_raise_planning_error(request_):
     assert refused.value.code == ErrorCode.INVALID_REQUEST
 
 
-@pytest.mark.xfail(strict=True, reason='core bug: with lengths near 1e-160 the squared '
-                   'distances in certify() are subnormal; the certificate overstates the '
-                   'clearance (2e-4 relative here) instead of refusing the plan')
 @pytest.mark.parametrize('variant', ['paper', 'spread'])
 def test_subnormal_scale_certificate_is_exact_or_refused(variant):
     """Every length scaled to 1e-160, lanes too: a correct certificate or a refusal."""

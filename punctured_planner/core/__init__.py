@@ -11,6 +11,9 @@ lanes and the composition of Remark 2.3), ``plan`` (the plan as breakpoints),
 from .certificate import Clearance
 from .errors import ErrorCode, PlanningError
 from .plan import Plan, plan
+from .sections import PAPER_LEGS, SPREAD_LEGS
 from .space import Frame, Workspace
+from .validation import MAX_COORDINATE
 
-__all__ = ['Clearance', 'ErrorCode', 'Frame', 'Plan', 'PlanningError', 'Workspace', 'plan']
+__all__ = ['Clearance', 'ErrorCode', 'Frame', 'MAX_COORDINATE', 'PAPER_LEGS', 'Plan',
+           'PlanningError', 'SPREAD_LEGS', 'Workspace', 'plan']

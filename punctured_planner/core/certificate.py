@@ -24,6 +24,8 @@ from .pairs import pair_difference_matrix, point_pairs
 # breakpoints and the closed form each round to a few ulps of the largest
 # coordinate, so anything closer than ~1e4 ulps may be an artefact.
 RELATIVE_RESOLUTION = 1e-12
+# Coordinate scales certified as they are; outside, rescaled by a power of two.
+_UNSCALED = (2.0 ** -60, 2.0 ** 60)
 # Up to this many robots every pair is evaluated on every leg (cheapest there).
 _DIRECT_ROBOTS = 64
 # Elements of (legs x pairs x d) arrays handled per chunk: bounds peak memory.
@@ -95,7 +97,8 @@ def _direct_minimum(points, robot_count, obstacle_count):
 
 
 def _breakpoint_bound(positions, obstacles):
-    """Return an upper bound on the clearance: the closest pair at a few breakpoints.
+    """
+    Return an upper bound on the clearance: the closest pair at a few breakpoints.
 
     Any instant's closest pair bounds the minimum; the first and last breakpoint
     and every tenth in between keep the bound tight without a tree per breakpoint.
@@ -173,11 +176,15 @@ def _closest(positions, obstacles):
     return min(best, found, key=lambda item: item[0])
 
 
+def coordinate_scale(positions, obstacles):
+    """Return the largest coordinate magnitude of the motion and the obstacles."""
+    return max(float(np.abs(positions).max(initial=0.0)),
+               float(np.abs(obstacles).max(initial=0.0)))
+
+
 def numerical_resolution(positions, obstacles):
     """Return the smallest clearance this motion can certify: RELATIVE_RESOLUTION x scale."""
-    scale = max(float(np.abs(positions).max(initial=0.0)),
-                float(np.abs(obstacles).max(initial=0.0)))
-    return RELATIVE_RESOLUTION * scale
+    return RELATIVE_RESOLUTION * coordinate_scale(positions, obstacles)
 
 
 def certify(times, positions, obstacles):
@@ -186,11 +193,19 @@ def certify(times, positions, obstacles):
 
     Exact (closed form per leg) over every robot pair and every robot-obstacle
     pair; the pruning for many robots drops only pairs that cannot be closest.
+    Far from unit scale the coordinates are first multiplied by a power of two
+    (exact), so squared distances neither overflow nor fall into subnormals.
     """
     k, r = positions.shape[1], len(obstacles)
     if k == 0 or (k == 1 and r == 0):
         return Clearance(np.inf, 'none', (), 0, 0.0, 0.0)
+    exponent = 0
+    scale = coordinate_scale(positions, obstacles)
+    if scale > 0 and not _UNSCALED[0] <= scale <= _UNSCALED[1]:
+        exponent = int(np.frexp(scale)[1])
+        positions, obstacles = np.ldexp(positions, -exponent), np.ldexp(obstacles, -exponent)
     distance, leg, first, second, fraction = _closest(positions, obstacles)
+    distance = float(np.ldexp(distance, exponent))
     tau = float(times[leg] + fraction * (times[leg + 1] - times[leg]))
     if second >= k:
         return Clearance(distance, 'obstacle', (first, second - k), leg, fraction, tau)

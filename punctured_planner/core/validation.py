@@ -19,19 +19,59 @@ MAX_COORDINATE = 1e15
 _PAIRWISE_ROBOTS = 32
 
 
+def _real_array(item, what):
+    """Return item as a float array, or raise INVALID_REQUEST if it is not real numbers."""
+    try:
+        array = np.asarray(item)
+        if array.dtype.kind not in 'biuf':
+            raise TypeError(f'elements of type {array.dtype}')
+        return array.astype(float)
+    except (TypeError, ValueError, OverflowError) as error:
+        raise PlanningError(ErrorCode.INVALID_REQUEST,
+                            f'{what} is not an array of real numbers: {error}') from None
+
+
+def _reject_out_of_range(configurations, first=0):
+    """
+    Raise INVALID_REQUEST for a finite coordinate beyond +-MAX_COORDINATE.
+
+    configurations is C_first as (k, d), or C_first.. as (n, k, d).
+    """
+    too_far = np.isfinite(configurations) & (np.abs(configurations) > MAX_COORDINATE)
+    if not too_far.any():
+        return
+    where = tuple(int(i) for i in np.argwhere(too_far)[0])
+    m, robot, axis = (0, *where) if configurations.ndim == 2 else where
+    raise PlanningError(ErrorCode.INVALID_REQUEST,
+                        f'configuration {first + m}, robot {robot}: coordinate {axis} is '
+                        f'{configurations[where]:.6g}, beyond the supported range '
+                        f'+-{MAX_COORDINATE:.0e}', configuration=first + m, robots=[robot])
+
+
 def _as_array(configurations, dimension):
-    """Return configurations as a float (n, k, d) array or raise a shape error."""
+    """
+    Return configurations as a float (n, k, d) array or raise a shape or range error.
+
+    The range (INVALID_REQUEST) is checked on each configuration before the
+    robot counts are compared (ROBOT_COUNT_MISMATCH): the smaller code wins.
+    """
     if isinstance(configurations, np.ndarray) and configurations.ndim == 3:
+        configurations = _real_array(configurations, 'the request')
         if configurations.shape[0] < 2:
             raise PlanningError(ErrorCode.NO_CONFIGURATIONS,
                                 f'need at least 2 configurations, got {configurations.shape[0]}')
         if configurations.shape[2] == dimension and configurations.shape[1] > 0:
-            return configurations.astype(float)
-    items = list(configurations)
+            _reject_out_of_range(configurations)
+            return configurations
+    try:
+        items = list(configurations)
+    except TypeError:
+        raise PlanningError(ErrorCode.INVALID_REQUEST,
+                            'configurations must be a sequence of (k, d) arrays') from None
     if len(items) < 2:
         raise PlanningError(ErrorCode.NO_CONFIGURATIONS,
                             f'need at least 2 configurations, got {len(items)}')
-    arrays = [np.asarray(item, dtype=float) for item in items]
+    arrays = [_real_array(item, f'configuration {m}') for m, item in enumerate(items)]
     for m, array in enumerate(arrays):
         if array.ndim != 2 or array.shape[1] != dimension:
             raise PlanningError(ErrorCode.INVALID_REQUEST,
@@ -41,6 +81,8 @@ def _as_array(configurations, dimension):
     if robot_count == 0:
         raise PlanningError(ErrorCode.INVALID_REQUEST, 'configuration 0 has no robots',
                             configuration=0)
+    for m, array in enumerate(arrays):
+        _reject_out_of_range(array, m)
     for m, array in enumerate(arrays):
         if array.shape[0] != robot_count:
             raise PlanningError(ErrorCode.ROBOT_COUNT_MISMATCH,
@@ -106,13 +148,6 @@ def validate_configurations(configurations, obstacles):
         raise PlanningError(ErrorCode.NON_FINITE_VALUE,
                             f'configuration {m}, robot {robot}: coordinate {axis} is '
                             f'{configurations[m, robot, axis]}', configuration=m, robots=[robot])
-    too_far = np.abs(configurations) > MAX_COORDINATE
-    if too_far.any():
-        m, robot, axis = (int(v) for v in np.argwhere(too_far)[0])
-        raise PlanningError(ErrorCode.INVALID_REQUEST,
-                            f'configuration {m}, robot {robot}: coordinate {axis} is '
-                            f'{configurations[m, robot, axis]:.6g}, beyond the supported '
-                            f'range +-{MAX_COORDINATE:.0e}', configuration=m, robots=[robot])
     coincident, on_obstacle = _coincidences(configurations, obstacles)
     if coincident is not None:
         m, a, b = coincident
