@@ -41,7 +41,7 @@ def build_request(data):
     return fill_message(PlanSequence.Request(), data)
 
 
-def call_service(node, executor, client, request, timeout_sec):
+def call_service(executor, client, request, timeout_sec):
     """
     Call ``client`` once; return the response, or None on timeout.
 
@@ -82,7 +82,7 @@ def _call(args):
                   % (args.service, args.wait), file=sys.stderr)
             return EXIT_NO_SERVICE
         executor.add_node(node)
-        response = call_service(node, executor, client, request, args.timeout)
+        response = call_service(executor, client, request, args.timeout)
         if response is None:
             print('punctured-planner: no response from %s within %.1f s'
                   % (args.service, args.timeout), file=sys.stderr)

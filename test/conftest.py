@@ -114,16 +114,11 @@ class RosClient:
 
     def call(self, client, request, timeout_sec=20.0):
         """Send ``request`` and return the response; fail the test on timeout."""
-        future = client.call_async(request)
-        deadline = time.monotonic() + timeout_sec
-        while not future.done():
-            remaining = deadline - time.monotonic()
-            if remaining <= 0:
-                client.remove_pending_request(future)
-                pytest.fail('no response from %s within %.1f s'
-                            % (client.srv_name, timeout_sec))
-            self.executor.spin_once(timeout_sec=min(remaining, 0.1))
-        return future.result()
+        from punctured_planner.cli import call_service
+        response = call_service(self.executor, client, request, timeout_sec)
+        if response is None:
+            pytest.fail('no response from %s within %.1f s' % (client.srv_name, timeout_sec))
+        return response
 
     def spin_until(self, predicate, timeout_sec=10.0):
         """Spin until ``predicate()`` is true; return whether it became true."""
