@@ -41,6 +41,7 @@ class Clearance:
     obstacle); leg is the breakpoint interval [leg, leg + 1] and fraction the
     position inside it, so tau = times[leg] + fraction (times[leg+1] - times[leg]).
     kind is 'none' (distance inf) when there is nothing to collide with.
+    resolution is the smallest distance the motion's coordinates can certify.
     """
 
     distance: float
@@ -49,6 +50,7 @@ class Clearance:
     leg: int
     fraction: float
     tau: float
+    resolution: float = 0.0
 
 
 def segment_minimum(start, velocity):
@@ -197,10 +199,11 @@ def certify(times, positions, obstacles):
     (exact), so squared distances neither overflow nor fall into subnormals.
     """
     k, r = positions.shape[1], len(obstacles)
-    if k == 0 or (k == 1 and r == 0):
-        return Clearance(np.inf, 'none', (), 0, 0.0, 0.0)
-    exponent = 0
     scale = coordinate_scale(positions, obstacles)
+    resolution = RELATIVE_RESOLUTION * scale
+    if k == 0 or (k == 1 and r == 0):
+        return Clearance(np.inf, 'none', (), 0, 0.0, 0.0, resolution)
+    exponent = 0
     if scale > 0 and not _UNSCALED[0] <= scale <= _UNSCALED[1]:
         exponent = int(np.frexp(scale)[1])
         positions, obstacles = np.ldexp(positions, -exponent), np.ldexp(obstacles, -exponent)
@@ -208,5 +211,6 @@ def certify(times, positions, obstacles):
     distance = float(np.ldexp(distance, exponent))
     tau = float(times[leg] + fraction * (times[leg + 1] - times[leg]))
     if second >= k:
-        return Clearance(distance, 'obstacle', (first, second - k), leg, fraction, tau)
-    return Clearance(distance, 'robots', (first, second), leg, fraction, tau)
+        return Clearance(distance, 'obstacle', (first, second - k), leg, fraction, tau,
+                         resolution)
+    return Clearance(distance, 'robots', (first, second), leg, fraction, tau, resolution)

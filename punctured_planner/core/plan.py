@@ -14,7 +14,7 @@ from functools import cached_property
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .certificate import certify, numerical_resolution
+from .certificate import certify
 from .complexity import domain_range, sequential_complexity
 from .deformations import desingularize, desingularizing_shift, spread
 from .errors import ErrorCode, PlanningError
@@ -171,8 +171,8 @@ def _check_required_clearance(result):
     numerical resolution of the coordinates (then rounding could hide a touch).
     """
     required = result.workspace.required_clearance
-    resolution = numerical_resolution(result.positions, result.workspace.obstacles)
     clearance = result.clearance
+    resolution = clearance.resolution
     if clearance.distance >= required and clearance.distance > resolution:
         return
     if clearance.distance > resolution:
