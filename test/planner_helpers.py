@@ -1,14 +1,13 @@
 """
 Helpers for the planner node tests: requests, an in-process node, latched subscribers.
 
-The in-process node runs in its own rclpy Context with a MultiThreadedExecutor
-spinning in a background thread (as ``main()`` runs it); the test talks to it
+The in-process node runs in its own rclpy Context, spun in background threads by
+planner_node's Spinner (as ``main()`` runs it); the test talks to it
 over real DDS from the ``ros_client`` fixture's own Context.
 """
 
 import itertools
 import os
-import threading
 import time
 
 import numpy as np
@@ -62,25 +61,22 @@ def unique_namespace(tag='inproc'):
 
 
 class InProcessPlanner:
-    """A PlannerNode in its own Context, spun by a MultiThreadedExecutor in a thread."""
+    """A PlannerNode in its own Context, spun by planner_node's Spinner in threads."""
 
     def __init__(self, namespace=None, **parameters):
         """Start the node with parameter overrides (name=value)."""
         import rclpy
-        from rclpy.executors import MultiThreadedExecutor
         from rclpy.parameter import Parameter
 
-        from punctured_planner.planner_node import PlannerNode
+        from punctured_planner.planner_node import PlannerNode, Spinner
         self.namespace = namespace or unique_namespace()
         self.context = rclpy.context.Context()
         rclpy.init(context=self.context, args=[])
         overrides = [Parameter(name, value=value) for name, value in parameters.items()]
         self.node = PlannerNode(context=self.context, namespace=self.namespace,
                                 parameter_overrides=overrides)
-        self.executor = MultiThreadedExecutor(num_threads=4, context=self.context)
-        self.executor.add_node(self.node)
-        self.thread = threading.Thread(target=self.executor.spin, daemon=True)
-        self.thread.start()
+        self.spinner = Spinner(self.node, context=self.context)
+        self.spinner.start()
 
     def name(self, relative):
         """Return the absolute name of one of the node's topics or services."""
@@ -95,8 +91,7 @@ class InProcessPlanner:
     def close(self):
         """Stop the executor thread, destroy the node, shut the Context down."""
         import rclpy
-        self.executor.shutdown()
-        self.thread.join(timeout=10)
+        self.spinner.shutdown()
         self.node.destroy_node()
         rclpy.try_shutdown(context=self.context)
 
