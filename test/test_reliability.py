@@ -70,6 +70,10 @@ def namespace(tag):
     return '/pp_rel_%s_%d' % (tag, os.getpid())
 
 
+# Every node process this module starts; the module teardown stops those still running.
+_STARTED = []
+
+
 def start_node(directory, ns, **overrides):
     """Start the installed planner_node in namespace ns with PARAMETERS (+ overrides)."""
     values = dict(PARAMETERS, **overrides)
@@ -80,7 +84,9 @@ def start_node(directory, ns, **overrides):
             '--params-file', params]
     log = os.path.join(str(directory), 'node%s_%d.log' % (ns.replace('/', '_'),
                                                           time.monotonic_ns()))
-    return NodeProcess(args, dict(os.environ), log, ns)
+    process = NodeProcess(args, dict(os.environ), log, ns)
+    _STARTED.append(process)
+    return process
 
 
 def service_type():
@@ -247,8 +253,12 @@ def check_plan_answer(response, expected, spec, sent_ns, received_ns):
 
 @pytest.fixture(scope='module')
 def module_dir(tmp_path_factory):
-    """Return a folder for this module's parameter files and node logs."""
-    return tmp_path_factory.mktemp('reliability')
+    """Yield a folder for this module's parameter files and node logs; stop leftover nodes."""
+    yield tmp_path_factory.mktemp('reliability')
+    while _STARTED:
+        process = _STARTED.pop()
+        if process.proc.poll() is None:
+            process.stop()
 
 
 @pytest.fixture(scope='module')
