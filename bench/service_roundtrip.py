@@ -16,12 +16,10 @@ size. Uses its own ROS_DOMAIN_ID (pid based) and localhost discovery.
 
 import argparse
 import os
-import signal
-import subprocess
 import sys
-import tempfile
 import time
 
+from node_session import planner_session
 import numpy as np
 
 OBSTACLES = [-2.0, 0.5, 0.0, 0.0, -0.5, 0.0, 2.5, 0.0, 0.0]
@@ -64,16 +62,6 @@ def call(executor, client, request, timeout_sec=120.0):
     return future.result()
 
 
-def start_node(namespace, log):
-    """Start the installed planner_node in its own process; return the Popen."""
-    script = os.path.join(os.path.dirname(sys.executable), 'planner_node')
-    args = [script, '--ros-args', '-r', '__ns:=' + namespace,
-            '-p', 'obstacles:=[%s]' % ','.join(str(v) for v in OBSTACLES),
-            '-p', 'max_poses:=100000000', '--log-level', 'warn']
-    return subprocess.Popen(args, stdout=log, stderr=subprocess.STDOUT,
-                            stdin=subprocess.DEVNULL)
-
-
 def measure(executor, client, k, n, calls, seed=1):
     """Return (round trips s, planning times s, response bytes) over `calls` calls."""
     from rclpy.serialization import serialize_message
@@ -102,26 +90,14 @@ def main(argv=None):
     parser.add_argument('-n', type=int, default=3, help='configurations (default: 3)')
     parser.add_argument('--calls', type=int, default=None, help='timed calls per k')
     args = parser.parse_args(argv)
-    os.environ.setdefault('ROS_DOMAIN_ID', str(1 + (os.getpid() + 50) % 101))
-    os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
-    os.environ.setdefault('ROS_LOG_DIR', tempfile.mkdtemp(prefix='pp_bench_log_'))
-
-    import rclpy
-    from rclpy.executors import SingleThreadedExecutor
-    from punctured_planner_interfaces.srv import PlanSequence
-
-    namespace = '/pp_bench_%d' % os.getpid()
-    log = tempfile.NamedTemporaryFile(prefix='pp_bench_node_', suffix='.log', delete=False)
-    node_process = start_node(namespace, log)
-    rclpy.init(args=[])
-    node = rclpy.create_node('service_roundtrip_bench')
-    executor = SingleThreadedExecutor()
-    executor.add_node(node)
-    try:
-        client = node.create_client(PlanSequence, namespace + '/plan_sequence')
+    parameters = {'obstacles': '[%s]' % ','.join(str(v) for v in OBSTACLES),
+                  'max_poses': 100000000}
+    with planner_session('bench', parameters) as session:
+        from punctured_planner_interfaces.srv import PlanSequence
+        client = session.node.create_client(PlanSequence, session.namespace + '/plan_sequence')
         started = time.perf_counter()
         if not client.wait_for_service(timeout_sec=30):
-            print('service not discovered; node log: %s' % log.name)
+            print('service not discovered; node log: %s' % session.log_path)
             return 1
         print('planner_node in its own process, discovered in %.2f s (ROS_DOMAIN_ID %s, %s)'
               % (time.perf_counter() - started, os.environ['ROS_DOMAIN_ID'],
@@ -132,20 +108,10 @@ def main(argv=None):
               % ('k', 'calls', 'median ms', 'p90 ms', 'min ms', 'planning ms', 'bytes'))
         for k in (SWEEP if args.sweep else (args.k,)):
             calls = args.calls or calls_for(k)
-            trips, planning, size = measure(executor, client, k, args.n, calls)
+            trips, planning, size = measure(session.executor, client, k, args.n, calls)
             print('%6d %6d %12.3f %12.3f %12.3f %14.3f %12d' % (
                 k, calls, np.median(trips) * 1e3, np.percentile(trips, 90) * 1e3,
                 trips.min() * 1e3, np.median(planning) * 1e3, size), flush=True)
-    finally:
-        executor.shutdown()
-        node.destroy_node()
-        rclpy.try_shutdown()
-        node_process.send_signal(signal.SIGINT)
-        try:
-            node_process.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            node_process.kill()
-        log.close()
     return 0
 
 

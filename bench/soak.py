@@ -24,12 +24,10 @@ not asserted.
 
 import argparse
 import os
-import signal
-import subprocess
 import sys
-import tempfile
 import time
 
+from node_session import planner_session
 import numpy as np
 
 OBSTACLES = ((-2.0, 0.5, 0.0), (0.0, -0.5, 0.0), (2.5, 0.0, 0.0))
@@ -107,18 +105,6 @@ def call(executor, client, request, timeout_sec=TIMEOUT_SEC):
             return None
         executor.spin_once(timeout_sec=0.05)
     return future.result()
-
-
-def start_node(namespace, log, log_level):
-    """Start the installed planner_node in its own process; return the Popen."""
-    script = os.path.join(os.path.dirname(sys.executable), 'planner_node')
-    obstacles = ','.join(str(v) for point in OBSTACLES for v in point)
-    args = [script, '--ros-args', '-r', '__ns:=' + namespace,
-            '-p', 'obstacles:=[%s]' % obstacles,
-            '-p', 'max_configurations:=%d' % MAX_CONFIGURATIONS,
-            '--log-level', log_level]
-    return subprocess.Popen(args, stdout=log, stderr=subprocess.STDOUT,
-                            stdin=subprocess.DEVNULL)
 
 
 def percentiles(values):
@@ -253,39 +239,18 @@ def main(argv=None):
     parser.add_argument('--seed', type=int, default=7)
     parser.add_argument('--log-level', default='info', help="the node's (default info)")
     args = parser.parse_args(argv)
-    os.environ.setdefault('ROS_DOMAIN_ID', str(1 + (os.getpid() + 70) % 101))
-    os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
-    os.environ.setdefault('ROS_LOG_DIR', tempfile.mkdtemp(prefix='pp_soak_log_'))
-
-    import rclpy
-    from rclpy.executors import SingleThreadedExecutor
-
-    namespace = '/pp_soak_%d' % os.getpid()
-    log = tempfile.NamedTemporaryFile(prefix='pp_soak_node_', suffix='.log', delete=False)
-    node_process = start_node(namespace, log, args.log_level)
-    rclpy.init(args=[])
-    node = rclpy.create_node('soak_bench')
-    executor = SingleThreadedExecutor()
-    executor.add_node(node)
-    try:
-        soak = Soak(node, executor, namespace, node_process.pid, args)
+    parameters = {'obstacles': '[%s]' % ','.join(str(v) for point in OBSTACLES for v in point),
+                  'max_configurations': MAX_CONFIGURATIONS}
+    with planner_session('soak', parameters, args.log_level, domain_offset=70) as session:
+        process = session.process
+        soak = Soak(session.node, session.executor, session.namespace, process.pid, args)
         print('planner_node pid %d (ROS_DOMAIN_ID %s, log %s); k = %d, n = %d, seed %d'
-              % (node_process.pid, os.environ['ROS_DOMAIN_ID'], log.name, args.k, args.n,
+              % (process.pid, os.environ['ROS_DOMAIN_ID'], session.log_path, args.k, args.n,
                  args.seed))
         elapsed, cpu = soak.run()
-        alive = node_process.poll() is None
+        alive = process.poll() is None
         report(soak, elapsed, cpu)
         print('node process alive at the end: %s' % alive)
-    finally:
-        executor.shutdown()
-        node.destroy_node()
-        rclpy.try_shutdown()
-        node_process.send_signal(signal.SIGINT)
-        try:
-            node_process.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            node_process.kill()
-        log.close()
     return 0
 
 
