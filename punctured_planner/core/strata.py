@@ -40,5 +40,5 @@ def epsilon(gaps, fallback):
     When every projection coincides (only possible for r <= 1) the set is empty;
     `fallback` / (k + r), a constant, keeps D continuous on that stratum.
     """
-    smallest = np.where(gaps > 0, gaps, np.inf).min(axis=1, initial=np.inf)
+    smallest = np.min(gaps, axis=1, where=gaps > 0, initial=np.inf)
     return np.where(np.isfinite(smallest), smallest, fallback) / (gaps.shape[1] + 1)

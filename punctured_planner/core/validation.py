@@ -35,11 +35,14 @@ def _reject_out_of_range(configurations, first=0):
     """
     Raise INVALID_REQUEST for a finite coordinate beyond +-MAX_COORDINATE.
 
-    configurations is C_first as (k, d), or C_first.. as (n, k, d).
+    configurations is C_first as (k, d), or C_first.. as (n, k, d). Returns
+    whether every coordinate is finite too (the usual case, found in one pass).
     """
+    if (np.abs(configurations) <= MAX_COORDINATE).all():
+        return True
     too_far = np.isfinite(configurations) & (np.abs(configurations) > MAX_COORDINATE)
     if not too_far.any():
-        return
+        return False
     where = tuple(int(i) for i in np.argwhere(too_far)[0])
     m, robot, axis = (0, *where) if configurations.ndim == 2 else where
     raise PlanningError(ErrorCode.INVALID_REQUEST,
@@ -50,7 +53,7 @@ def _reject_out_of_range(configurations, first=0):
 
 def _as_array(configurations, dimension):
     """
-    Return configurations as a float (n, k, d) array or raise a shape or range error.
+    Return (configurations as a float (n, k, d) array, all finite) or raise a shape error.
 
     The range (INVALID_REQUEST) is checked on each configuration before the
     robot counts are compared (ROBOT_COUNT_MISMATCH): the smaller code wins.
@@ -61,8 +64,7 @@ def _as_array(configurations, dimension):
             raise PlanningError(ErrorCode.NO_CONFIGURATIONS,
                                 f'need at least 2 configurations, got {configurations.shape[0]}')
         if configurations.shape[2] == dimension and configurations.shape[1] > 0:
-            _reject_out_of_range(configurations)
-            return configurations
+            return configurations, _reject_out_of_range(configurations)
     try:
         items = list(configurations)
     except TypeError:
@@ -81,14 +83,13 @@ def _as_array(configurations, dimension):
     if robot_count == 0:
         raise PlanningError(ErrorCode.INVALID_REQUEST, 'configuration 0 has no robots',
                             configuration=0)
-    for m, array in enumerate(arrays):
-        _reject_out_of_range(array, m)
+    finite = all([_reject_out_of_range(array, m) for m, array in enumerate(arrays)])
     for m, array in enumerate(arrays):
         if array.shape[0] != robot_count:
             raise PlanningError(ErrorCode.ROBOT_COUNT_MISMATCH,
                                 f'configuration {m} has {array.shape[0]} robots, '
                                 f'configuration 0 has {robot_count}', configuration=m)
-    return np.stack(arrays)
+    return np.stack(arrays), finite
 
 
 def _sorted_coincidence(configurations):
@@ -141,10 +142,9 @@ def _coincidences(configurations, obstacles):
 
 def validate_configurations(configurations, obstacles):
     """Return the request as a float (n, k, d) array after every check, or raise PlanningError."""
-    configurations = _as_array(configurations, obstacles.shape[1])
-    finite = np.isfinite(configurations)
-    if not finite.all():
-        m, robot, axis = (int(v) for v in np.argwhere(~finite)[0])
+    configurations, all_finite = _as_array(configurations, obstacles.shape[1])
+    if not all_finite:
+        m, robot, axis = (int(v) for v in np.argwhere(~np.isfinite(configurations))[0])
         raise PlanningError(ErrorCode.NON_FINITE_VALUE,
                             f'configuration {m}, robot {robot}: coordinate {axis} is '
                             f'{configurations[m, robot, axis]}', configuration=m, robots=[robot])
