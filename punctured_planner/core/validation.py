@@ -83,7 +83,9 @@ def _as_array(configurations, dimension):
     if robot_count == 0:
         raise PlanningError(ErrorCode.INVALID_REQUEST, 'configuration 0 has no robots',
                             configuration=0)
-    finite = all([_reject_out_of_range(array, m) for m, array in enumerate(arrays)])
+    finite = True
+    for m, array in enumerate(arrays):  # every one: a later range fault outranks NaN
+        finite &= _reject_out_of_range(array, m)
     for m, array in enumerate(arrays):
         if array.shape[0] != robot_count:
             raise PlanningError(ErrorCode.ROBOT_COUNT_MISMATCH,
