@@ -3,8 +3,9 @@
 from core_strategies import requests
 from hypothesis import given, HealthCheck, settings
 import numpy as np
+from punctured_planner.core import deformations
 from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
-from punctured_planner.core.deformations import spread
+from punctured_planner.core.deformations import pool_adjacent_violators, spread
 import pytest
 
 PROPERTY = settings(max_examples=150, deadline=None,
@@ -88,3 +89,21 @@ def test_required_clearance_refuses_with_pair_leg_and_distance():
     assert 'leg' in message and '0.333333 < required 0.4' in message
     relaxed = Workspace(obstacles, variant='spread', min_spacing=0.5, required_clearance=0.3)
     assert plan(relaxed, request).min_clearance == pytest.approx(1 / 3)
+
+
+def test_fallback_isotonic_fit_equals_scipy():
+    """The pool-adjacent-violators fallback (SciPy < 1.12) gives SciPy's fit."""
+    from scipy.optimize import isotonic_regression
+    rng = np.random.default_rng(5)
+    for size in (1, 2, 3, 7, 40):
+        values = rng.normal(size=size).round(2)
+        assert np.allclose(pool_adjacent_violators(values), isotonic_regression(values).x)
+
+
+def test_spread_without_scipy_isotonic_regression(monkeypatch):
+    """With SciPy's isotonic regression missing, S uses the fallback and spreads the same."""
+    projections = np.array([[0.1, 0.11, 0.12, 2.2, 2.1001, 5.0]])
+    expected, _ = spread(np.sort(projections), np.array([0.0, 1.0, 3.0]), 0.5)
+    monkeypatch.setattr(deformations, 'isotonic_regression', None)
+    fallback, _ = spread(np.sort(projections), np.array([0.0, 1.0, 3.0]), 0.5)
+    assert np.allclose(fallback, expected)

@@ -10,7 +10,36 @@ The deformations that carry any configuration onto the axis: D, S and phi.
 """
 
 import numpy as np
-from scipy.optimize import isotonic_regression
+
+try:
+    from scipy.optimize import isotonic_regression
+except ImportError:  # SciPy < 1.12: Ubuntu 24.04's python3-scipy (ROS 2 Jazzy) is 1.11
+    isotonic_regression = None
+
+
+def pool_adjacent_violators(values):
+    """
+    Return the non-decreasing least-squares fit of values (unit weights).
+
+    The classic pool-adjacent-violators pass; used only where SciPy lacks
+    scipy.optimize.isotonic_regression (before 1.12).
+    """
+    means, counts = [], []
+    for value in values:
+        means.append(float(value))
+        counts.append(1)
+        while len(means) > 1 and means[-2] > means[-1]:
+            mean, count = means.pop(), counts.pop()
+            means[-1] = (means[-1] * counts[-1] + mean * count) / (counts[-1] + count)
+            counts[-1] += count
+    return np.repeat(means, counts)
+
+
+def isotonic_fit(values):
+    """Return the non-decreasing least-squares fit of values: SciPy's, or the fallback."""
+    if isotonic_regression is None:
+        return pool_adjacent_violators(values)
+    return isotonic_regression(values).x
 
 
 def desingularizing_shift(projection_counts, eps, robot_count, obstacle_count):
@@ -67,7 +96,7 @@ def spread(projections, sorted_obstacle_projections, min_spacing):
     disordered = np.unique(np.searchsorted(starts, descending, side='right') - 1)
     for start, size in zip(starts[disordered], sizes[disordered]):
         block = slice(start, start + size)
-        z[block] = isotonic_regression(z[block]).x
+        z[block] = isotonic_fit(z[block])
     z = np.clip(z, low, high - (count + 1) * spacing)
     result = np.empty(n * k)
     result[order] = z + (rank + 1) * spacing
