@@ -306,10 +306,18 @@ def fill_response(response, plan, paths, planning_time, max_speed):
 
 
 def fill_error(response, code, message, planning_time=0.0, min_clearance=None):
-    """Fill a PlanSequence response for a refused request (no plan, no paths)."""
+    """
+    Fill a PlanSequence response for a refused request (no plan, no paths).
+
+    Every plan field is reset, so a failure after a partial fill leaves nothing behind.
+    """
     response.error_code = int(code)
     response.error_msg = str(message)
+    response.domain_index = response.domain_count = response.sequential_complexity = 0
+    response.optimal = False
+    response.projection_counts = []
+    response.min_clearance = float(min_clearance) if min_clearance is not None else 0.0
     response.planning_time = duration_from_seconds(planning_time)
-    if min_clearance is not None:
-        response.min_clearance = float(min_clearance)
+    response.duration = Duration()
+    response.paths = []
     return response

@@ -16,15 +16,15 @@ message and, when ``robot_names`` is set, the state assembled from every
 robot's ``<name>/odom`` (complete once each robot has reported; as old as its
 oldest message).
 
-Concurrency: the subscriptions live on a companion node, ``planner_node_inputs``
-(same namespace and context), spun by its own single-threaded executor in its
-own thread; the service (one plan at a time) and the parameters are spun by
-another. Planning therefore never blocks the subscriptions. Not rclpy's
-MultiThreadedExecutor: in rclpy 7.1 it busy-loops on subscription traffic
-(ros2/rclpy#1223, #1452), and measured here, with obstacles and robot states at
-50 Hz, service round trips went from 4 ms to 80 ms median with stalls of
-2-6 s (two single-threaded executors: 3.4 ms, worst 6 ms). A plan is published
-only once it is complete.
+Concurrency: the subscriptions live on a companion node, ``<name>_inputs``
+(``planner_node_inputs`` by default; same namespace and context), spun by its
+own single-threaded executor in its own thread; the service (one plan at a
+time) and the parameters are spun by another. Planning therefore never blocks
+the subscriptions. Not rclpy's MultiThreadedExecutor: in rclpy 7.1 it busy-
+loops on subscription traffic (ros2/rclpy#1223, #1452), and measured here, with
+obstacles and robot states at 50 Hz, service round trips went from 4 ms to 80
+ms median with stalls of 2-6 s (two single-threaded executors: 3.4 ms, worst 6
+ms). A plan is published only once it is complete.
 """
 
 import sys
@@ -88,8 +88,11 @@ class PlannerNode(Node):
         self._odometry = {}  # name -> (position, orientation, frame_id, stamp_ns, received_ns)
 
         # The subscriptions' own node: spun apart from the service (module docstring).
-        self.inputs = Node(NODE_NAME + '_inputs', context=self.context,
-                           namespace=self.get_namespace())
+        # A local __node remap outranks a global one (-r __node:=NAME, launch name=).
+        inputs_name = self.get_name() + '_inputs'
+        self.inputs = Node(inputs_name, context=self.context, namespace=self.get_namespace(),
+                           cli_args=['--ros-args', '-r', '__node:=' + inputs_name],
+                           start_parameter_services=False)
         self.inputs.create_subscription(PoseArray, 'obstacles', self._on_obstacles, LATCHED)
         self.inputs.create_subscription(PoseArray, 'robot_states', self._on_robot_states,
                                         STATE)
@@ -125,6 +128,12 @@ class PlannerNode(Node):
 
     def _after_set_parameters(self, parameters):
         """Take the accepted values into the settings the next request will use."""
+        try:
+            self._apply_parameters(parameters)
+        except Exception as error:  # noqa: B902 - a parameter change never stops the node
+            self.get_logger().error('applying parameters failed: %r' % error)
+
+    def _apply_parameters(self, parameters):
         changed = {p.name for p in parameters}
         settings = settings_from_values(self._parameter_values())
         with self._lock:
@@ -178,7 +187,9 @@ class PlannerNode(Node):
         entry = (position, orientation, msg.header.frame_id,
                  conversions.stamp_to_ns(msg.header.stamp), self.get_clock().now().nanoseconds)
         with self._lock:
-            self._odometry[name] = entry
+            # A late message for a robot just removed from robot_names is dropped.
+            if name in self._settings.robot_names:
+                self._odometry[name] = entry
 
     def _current_state(self, settings):
         """Return (RobotState or None, why none); call with the lock held."""
@@ -229,7 +240,7 @@ class PlannerNode(Node):
                 logger.error('plan_sequence #%d: publishing failed: %r' % (number, error))
                 conversions.fill_error(response, PlanSequence.Response.UNKNOWN,
                                        'internal error while publishing: %s' % error)
-                response.paths = []
+                self._retract(outcome.names, snapshot.settings)
                 return response
             p = outcome.plan
             logger.info('plan_sequence #%d: planned k=%d n=%d, domain %d of %d, clearance '
@@ -242,8 +253,8 @@ class PlannerNode(Node):
             logger.error('plan_sequence #%d: %s' % (number, response.error_msg))
             logger.error(''.join(traceback.format_exception(outcome.exception)))
         else:
-            logger.warn('plan_sequence #%d: error %d: %s'
-                        % (number, response.error_code, response.error_msg))
+            logger.warning('plan_sequence #%d: error %d: %s'
+                           % (number, response.error_code, response.error_msg))
         return response
 
     def _publish(self, outcome, settings):
@@ -266,6 +277,15 @@ class PlannerNode(Node):
         """Destroy the inputs node too."""
         self.inputs.destroy_node()
         return super().destroy_node()
+
+    def _retract(self, names, settings):
+        """After a failed publish, latch empty paths so no robot keeps a partial plan."""
+        try:
+            for name in names:
+                self._path_publisher(name).publish(
+                    conversions.empty_path(settings.frame_id, self.get_clock().now().nanoseconds))
+        except Exception as error:  # noqa: B902 - the service answers UNKNOWN regardless
+            self.get_logger().error('could not retract the partial plan: %r' % error)
 
     def _path_publisher(self, name):
         publisher = self._path_publishers.get(name)

@@ -95,7 +95,7 @@ class Outcome:
     start_ns: int = 0
     max_speed: float = 0.0
     exception: BaseException = None
-    core_input: tuple = None  # (workspace, configurations) given to the core
+    workspace: object = None  # the core Workspace the request was planned in
 
     @property
     def ok(self):
@@ -155,9 +155,7 @@ class Planner:
         try:
             self._plan(request, snapshot, now_ns, started, outcome)
         except PlanningError as error:
-            minimum = None
-            if error.code == ErrorCode.CLEARANCE_BELOW_REQUIRED:
-                minimum = self._clearance_found(outcome)
+            minimum = error.clearance.distance if error.clearance is not None else None
             conversions.fill_error(response, error.code, self._message(error, request),
                                    time.perf_counter() - started, minimum)
             outcome.plan = outcome.paths = None
@@ -176,14 +174,6 @@ class Planner:
             message += (' (configuration 0 is the current robot state, configuration m is '
                         'configurations[m - 1] of the request)')
         return message
-
-    @staticmethod
-    def _clearance_found(outcome):
-        """Return the certified clearance of the refused plan (CLEARANCE_BELOW_REQUIRED)."""
-        if outcome.core_input is None:
-            return None
-        workspace, configurations = outcome.core_input
-        return core_plan(workspace, configurations, certify=False).min_clearance
 
     def _plan(self, request, snapshot, now_ns, started, outcome):
         settings = snapshot.settings
@@ -237,7 +227,7 @@ class Planner:
         d = settings.dimension
         workspace = self.workspace(settings, conversions.planar(obstacles.points, d))
         planar = conversions.planar(positions, d)
-        outcome.core_input = (workspace, planar)
+        outcome.workspace = workspace
         the_plan = core_plan(workspace, planar)
         planning_time = time.perf_counter() - started
         start_ns = int(now_ns) + int(round(planning_time * 1e9))

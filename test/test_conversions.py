@@ -136,7 +136,7 @@ def test_planner_caches_one_workspace_per_obstacle_set():
     outcome = planner.handle(make_request(), PlanSequence.Response(), base, 0)
     assert outcome.ok and outcome.names == ['robot_0', 'robot_1', 'robot_2', 'robot_3']
     assert outcome.start_ns > 0
-    assert outcome.core_input[0] is first
+    assert outcome.workspace is first
 
 
 def test_over_limit_requests_are_refused_before_conversion():

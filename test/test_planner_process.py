@@ -79,3 +79,19 @@ def test_invalid_parameters_stop_the_node(planner_process, arguments):
         pytest.fail('planner_node kept running with %s:\n%s' % (arguments, node.log()))
     assert code == 2, node.log()
     assert 'invalid parameters' in node.log()
+
+
+def test_renamed_node_keeps_its_companion_apart(planner_process, ros_client):
+    """Under -r __node:=NAME (a launch name=) the inputs node is NAME_inputs, not NAME twice."""
+    from punctured_planner_interfaces.srv import PlanSequence
+    node = planner_process('-r', '__node:=fleet_planner')
+    client = ros_client.node.create_client(PlanSequence, node.name('plan_sequence'))
+    ros_client.wait_for_service(client)
+    namespace = node.name('')[:-1]
+
+    def names():
+        return [name for name, ns in ros_client.node.get_node_names_and_namespaces()
+                if ns == namespace]
+    assert ros_client.spin_until(lambda: len(names()) >= 2, 10), names()
+    assert sorted(names()) == ['fleet_planner', 'fleet_planner_inputs']
+    assert node.stop() == 0, node.log()

@@ -35,13 +35,16 @@ class PlanningError(ValueError):
     indices involved, ``obstacle`` the obstacle index (or None).
     """
 
-    def __init__(self, code, message, configuration=None, robots=(), obstacle=None):
+    def __init__(self, code, message, configuration=None, robots=(), obstacle=None,
+                 clearance=None):
         """Store the code and the culprit; the message is the human-readable reason."""
         super().__init__(message)
         self.code = ErrorCode(code)
         self.configuration = configuration
         self.robots = tuple(int(i) for i in robots)
         self.obstacle = obstacle
+        # The refused plan's Clearance certificate (CLEARANCE_BELOW_REQUIRED only).
+        self.clearance = clearance
 
     def __str__(self):
         """Return the message prefixed by the code name."""

@@ -189,4 +189,4 @@ def _check_required_clearance(result):
         f'{clearance.leg} ({result.leg_names[clearance.leg]} of segment C_{segment + 1} -> '
         f'C_{segment + 2}) at tau {clearance.tau:.6g}',
         configuration=segment, robots=[a] if clearance.kind == 'obstacle' else [a, b],
-        obstacle=b if clearance.kind == 'obstacle' else None)
+        obstacle=b if clearance.kind == 'obstacle' else None, clearance=clearance)
