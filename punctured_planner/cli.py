@@ -158,7 +158,7 @@ def _plan(args):
     if not outcome.ok:
         return code
     title = os.path.basename(args.request) if args.request != '-' else None
-    written = render_outputs(args, outcome.plan, title=title)
+    written = render_outputs(args, outcome.plan, title=title, max_speed=outcome.max_speed)
     if args.mcap:
         written.append(record_plan(args.mcap, outcome, settings))
     for path in written:

@@ -321,3 +321,18 @@ def fill_error(response, code, message, planning_time=0.0, min_clearance=None):
     response.duration = Duration()
     response.paths = []
     return response
+
+
+def plan_messages(outcome, settings):
+    """
+    Return [(topic, message)] of a successful planning Outcome, as the node publishes them.
+
+    Topics are relative: ``<robot>/plan`` per robot, ``plan_markers``, ``domain_index``.
+    """
+    messages = [('%s/plan' % name.strip('/'), path)
+                for name, path in zip(outcome.names, outcome.paths)]
+    messages.append(('plan_markers', plan_markers(outcome.plan, settings.frame_id,
+                                                  outcome.start_ns, settings.plane_z,
+                                                  outcome.names)))
+    messages.append(('domain_index', domain_index_message(outcome.plan)))
+    return messages

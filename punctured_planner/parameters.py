@@ -87,7 +87,6 @@ PARAMETERS = (
          '(REQUEST_OVER_LIMITS above).', low=1, high=1000000000),
 )
 SPECS = {spec.name: spec for spec in PARAMETERS}
-DEFAULTS = {spec.name: spec.default for spec in PARAMETERS}
 
 
 @dataclass(frozen=True)
@@ -200,12 +199,6 @@ def settings_from_values(values):
         raise ValueError('%d robots configured but max_robots is %d'
                          % (settings.expected_robot_count, settings.max_robots))
     return settings
-
-
-def settings_values(settings):
-    """Return the parameter values of settings as a dict (lists for the arrays)."""
-    return {spec.name: (list(getattr(settings, spec.name)) if spec.kind.endswith('_array')
-                        else getattr(settings, spec.name)) for spec in PARAMETERS}
 
 
 def load_parameter_file(path, node_name=NODE_NAME):

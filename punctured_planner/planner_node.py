@@ -98,10 +98,10 @@ class PlannerNode(Node):
                                         STATE)
         self._odometry_subscriptions = {}
         self._update_odometry_subscriptions(self._settings.robot_names)
-        self._path_publishers = {}
+        self._latched_publishers = {}  # relative topic -> publisher
         self._latched_names = []
-        self._domain_publisher = self.create_publisher(UInt32, 'domain_index', LATCHED)
-        self._marker_publisher = self.create_publisher(MarkerArray, 'plan_markers', LATCHED)
+        for topic, msg_type in (('domain_index', UInt32), ('plan_markers', MarkerArray)):
+            self._publisher(topic, msg_type)
         self._service = self.create_service(PlanSequence, 'plan_sequence',
                                             self._on_plan_sequence)
         s = self._settings
@@ -259,19 +259,15 @@ class PlannerNode(Node):
 
     def _publish(self, outcome, settings):
         """Publish the complete plan: every robot's Path, stale robots emptied, markers, index."""
-        markers = conversions.plan_markers(outcome.plan, settings.frame_id, outcome.start_ns,
-                                           settings.plane_z, outcome.names)
-        index = conversions.domain_index_message(outcome.plan)
-        publishers = [self._path_publisher(name) for name in outcome.names]
+        messages = conversions.plan_messages(outcome, settings)
+        publishers = [self._publisher(topic, type(message)) for topic, message in messages]
         stale = [name for name in self._latched_names if name not in set(outcome.names)]
-        for publisher, path in zip(publishers, outcome.paths):
-            publisher.publish(path)
+        for publisher, (_, message) in zip(publishers, messages):
+            publisher.publish(message)
         for name in stale:
-            self._path_publisher(name).publish(
+            self._publisher(name + '/plan', Path).publish(
                 conversions.empty_path(settings.frame_id, outcome.start_ns))
         self._latched_names = list(outcome.names)
-        self._marker_publisher.publish(markers)
-        self._domain_publisher.publish(index)
 
     def destroy_node(self):
         """Destroy the inputs node too."""
@@ -282,16 +278,17 @@ class PlannerNode(Node):
         """After a failed publish, latch empty paths so no robot keeps a partial plan."""
         try:
             for name in names:
-                self._path_publisher(name).publish(
+                self._publisher(name + '/plan', Path).publish(
                     conversions.empty_path(settings.frame_id, self.get_clock().now().nanoseconds))
         except Exception as error:  # noqa: B902 - the service answers UNKNOWN regardless
             self.get_logger().error('could not retract the partial plan: %r' % error)
 
-    def _path_publisher(self, name):
-        publisher = self._path_publishers.get(name)
+    def _publisher(self, topic, msg_type):
+        """Return the latched publisher of a relative topic, created on first use."""
+        publisher = self._latched_publishers.get(topic)
         if publisher is None:
-            publisher = self.create_publisher(Path, name + '/plan', LATCHED)
-            self._path_publishers[name] = publisher
+            publisher = self.create_publisher(msg_type, topic, LATCHED)
+            self._latched_publishers[topic] = publisher
         return publisher
 
 

@@ -105,17 +105,6 @@ def _type_name(message):
     return '%s/msg/%s' % (module[0], type(message).__name__)
 
 
-def plan_messages(outcome, settings):
-    """Return [(topic, message)] of a successful planning Outcome, as the node publishes."""
-    from . import conversions
-    messages = [('/%s/plan' % name.strip('/'), path)
-                for name, path in zip(outcome.names, outcome.paths)]
-    messages.append(('/plan_markers', conversions.plan_markers(
-        outcome.plan, settings.frame_id, outcome.start_ns, settings.plane_z, outcome.names)))
-    messages.append(('/domain_index', conversions.domain_index_message(outcome.plan)))
-    return messages
-
-
 def write_mcap(path, messages, log_time_ns, metadata=None):
     """
     Write [(topic, message)] to an MCAP file at ``path``; return the path.
@@ -166,4 +155,7 @@ def record_plan(path, outcome, settings):
         'max_speed': outcome.max_speed, 'robots': ','.join(outcome.names),
         'projection_counts': ','.join(str(int(c)) for c in p.projection_counts),
     }
-    return write_mcap(path, plan_messages(outcome, settings), outcome.start_ns, metadata)
+    from . import conversions
+    messages = [('/' + topic, message)
+                for topic, message in conversions.plan_messages(outcome, settings)]
+    return write_mcap(path, messages, outcome.start_ns, metadata)

@@ -52,7 +52,7 @@ def add_render_arguments(parser):
     return group
 
 
-def render_outputs(args, plan, title=None):
+def render_outputs(args, plan, title=None, max_speed=1.0):
     """Write the pictures asked for by add_render_arguments' options; return their paths."""
     written = []
     if getattr(args, 'png', None):
@@ -60,7 +60,7 @@ def render_outputs(args, plan, title=None):
     if getattr(args, 'gif', None):
         written.append(render_animation(plan, args.gif, fps=args.gif_fps,
                                         seconds=args.gif_seconds, dpi=args.gif_dpi,
-                                        title=title))
+                                        title=title, max_speed=max_speed))
     return written
 
 

@@ -164,8 +164,9 @@ class NodeProcess:
         return '%s/%s' % (self.namespace.rstrip('/'), relative)
 
     def log(self):
-        """Return what the process printed so far."""
-        self._log.flush()
+        """Return what the process printed so far (also after stop())."""
+        if not self._log.closed:
+            self._log.flush()
         with open(self.log_path, 'rb') as stream:
             return stream.read().decode('utf-8', 'replace')
 

@@ -13,12 +13,6 @@ def domain_range(configuration_count, robot_count, obstacle_count):
     return n * max(r, 1), n * (k + r)
 
 
-def domain_count(configuration_count, robot_count, obstacle_count):
-    """Return the number of domains of continuity of the algorithm."""
-    low, high = domain_range(configuration_count, robot_count, obstacle_count)
-    return high - low + 1
-
-
 def sequential_complexity(configuration_count, robot_count, obstacle_count, dimension):
     """
     Return TC_n(F(R^d - Q_r, k)), non-reduced (paper, Theorem 1.1, González–Grant).
