@@ -15,8 +15,9 @@ import re
 
 import yaml
 
+from .core.space import VARIANTS
+
 NODE_NAME = 'planner_node'
-VARIANTS = ('spread', 'paper')
 # Largest samples_per_leg a parameter or a request may ask for.
 MAX_SAMPLES_PER_LEG = 1000
 # Names usable as the first token of '<name>/plan' and '<name>/odom'.

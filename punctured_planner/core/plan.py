@@ -38,7 +38,8 @@ class Plan:
         self.times = times
         self.positions = positions
         self.leg_names = leg_names
-        self.waypoint_indices = np.arange(n) * (len(leg_names) // (n - 1))
+        self.legs_per_segment = len(leg_names) // (n - 1)
+        self.waypoint_indices = np.arange(n) * self.legs_per_segment
         self.projection_counts = projection_counts
         self.domain = int(projection_counts.sum())
         low, high = domain_range(n, k, r)
@@ -182,7 +183,7 @@ def _check_required_clearance(result):
     a, b = clearance.indices
     what = (f'robots {a} and {b}' if clearance.kind == 'robots'
             else f'robot {a} and obstacle {b}')
-    segment = clearance.leg // (len(result.leg_names) // (result.configurations.shape[0] - 1))
+    segment = clearance.leg // result.legs_per_segment
     raise PlanningError(
         ErrorCode.CLEARANCE_BELOW_REQUIRED,
         f'{what} come within {clearance.distance:.6g} {limit} on leg '
