@@ -9,28 +9,32 @@ import numpy as np
 
 
 def all_projections(robot_projections, obstacle_projections):
-    """Return (n, r + k) projections in the paper's numbering: obstacles first, then robots."""
-    n, k = robot_projections.shape
+    """Return (..., r + k) projections in the paper's numbering: obstacles first, then robots."""
+    k = robot_projections.shape[-1]
     r = obstacle_projections.size
-    points = np.empty((n, r + k))
-    points[:, :r] = obstacle_projections
-    points[:, r:] = robot_projections
+    points = np.empty(robot_projections.shape[:-1] + (r + k,))
+    points[..., :r] = obstacle_projections
+    points[..., r:] = robot_projections
     return points
 
 
 def projection_gaps(robot_projections, obstacle_projections):
-    """Return the (n, k + r - 1) gaps between consecutive sorted projections of each C_m."""
-    ordered = np.sort(all_projections(robot_projections, obstacle_projections), axis=1)
-    return ordered[:, 1:] - ordered[:, :-1]
+    """
+    Return the (..., k + r - 1) gaps between consecutive sorted projections of each C_m.
+
+    robot_projections is (..., k): any number of configurations, of any batch shape.
+    """
+    ordered = np.sort(all_projections(robot_projections, obstacle_projections), axis=-1)
+    return ordered[..., 1:] - ordered[..., :-1]
 
 
 def projection_count(gaps):
     """
     Return cp(C_m) for each configuration: distinct projections among all k + r points.
 
-    gaps are the (n, k + r - 1) sorted projection gaps; the result is (n,) ints.
+    gaps are the (..., k + r - 1) sorted projection gaps; the result is (...) ints.
     """
-    return 1 + np.count_nonzero(gaps > 0, axis=1)
+    return 1 + np.count_nonzero(gaps > 0, axis=-1)
 
 
 def epsilon(gaps, fallback):

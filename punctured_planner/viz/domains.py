@@ -12,6 +12,9 @@ strata are lines and points, so every grid axis contains the special values
 
 import numpy as np
 
+from ..core.pairs import point_pairs
+from ..core.strata import projection_count, projection_gaps
+
 
 def snapped_axis(low, high, count, special=()):
     """
@@ -29,31 +32,20 @@ def snapped_axis(low, high, count, special=()):
 
 def _invalid(configurations, obstacles):
     """Return (...,) True where some C_m has a robot on an obstacle or two robots at one point."""
-    k = configurations.shape[-2]
-    bad = np.zeros(configurations.shape[:-3], dtype=bool)
+    a, b = point_pairs(configurations.shape[-2])
+    same = np.all(configurations[..., a, :] == configurations[..., b, :], axis=-1)
+    bad = same.any(axis=(-2, -1))
     if len(obstacles):
         on = np.all(configurations[..., :, None, :] == obstacles, axis=-1)
         bad |= on.any(axis=(-3, -2, -1))
-    for a in range(k):
-        for b in range(a + 1, k):
-            same = np.all(configurations[..., a, :] == configurations[..., b, :], axis=-1)
-            bad |= same.any(axis=-1)
     return bad
-
-
-def projection_counts(robot_projections, obstacle_projections):
-    """Return cp for robot projections (..., k): distinct values among them and the obstacles'."""
-    shape = robot_projections.shape
-    obstacles = np.broadcast_to(obstacle_projections, shape[:-1] + obstacle_projections.shape)
-    values = np.sort(np.concatenate([obstacles, robot_projections], axis=-1), axis=-1)
-    return 1 + np.count_nonzero(np.diff(values, axis=-1) > 0, axis=-1)
 
 
 def domain_values(workspace, configurations):
     """Return the domain l of every request in configurations (..., n, k, d); NaN if refused."""
     configurations = np.asarray(configurations, dtype=float)
     projections = workspace.frame.project(configurations)
-    counts = projection_counts(projections, workspace.obstacle_projections)
+    counts = projection_count(projection_gaps(projections, workspace.obstacle_projections))
     values = counts.sum(axis=-1).astype(float)
     values[_invalid(configurations, workspace.obstacles)] = np.nan
     return values
