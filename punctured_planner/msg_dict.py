@@ -36,6 +36,14 @@ def _element_type(type_name):
     return None
 
 
+def _integer_range(type_name):
+    """Return (lowest, highest) of an IDL integer type name such as 'int32' or 'uint16'."""
+    bits = int(''.join(c for c in type_name if c.isdigit()) or 8)
+    if type_name.startswith('u') or type_name in ('octet', 'char'):
+        return 0, 2 ** bits - 1
+    return -2 ** (bits - 1), 2 ** (bits - 1) - 1
+
+
 def _convert_scalar(type_name, value, where):
     if type_name == 'boolean':
         if not isinstance(value, bool):
@@ -48,6 +56,9 @@ def _convert_scalar(type_name, value, where):
     if 'int' in type_name or type_name in ('octet', 'char'):
         if isinstance(value, bool) or not isinstance(value, int):
             raise ValueError('%s: expected an integer, got %r' % (where, value))
+        low, high = _integer_range(type_name)
+        if not low <= value <= high:
+            raise ValueError('%s: %d is outside the range of %s' % (where, value, type_name))
         return value
     if 'string' in type_name:
         if not isinstance(value, str):

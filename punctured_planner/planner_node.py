@@ -304,7 +304,7 @@ class Spinner:
         self._threads = [threading.Thread(target=self.inputs_executor.spin, daemon=True)]
 
     def start(self):
-        """Spin both executors in background threads."""
+        """Spin both executors in background threads (call this or spin, once)."""
         self._threads.append(threading.Thread(target=self.service_executor.spin, daemon=True))
         for thread in self._threads:
             thread.start()

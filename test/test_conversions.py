@@ -167,3 +167,13 @@ def test_full_definition_text_for_recordings():
         assert ('MSG: %s\n' % name) in text
     with pytest.raises(LookupError):
         message_definition('nav_msgs/msg/NoSuchType')
+
+
+def test_request_yaml_integers_out_of_range_are_refused():
+    """An int32 field given 99999999999 is a clear error, not a silently wrapped value."""
+    from punctured_planner.msg_dict import fill_message
+    from punctured_planner_interfaces.srv import PlanSequence
+    with pytest.raises(ValueError, match='outside the range of int32'):
+        fill_message(PlanSequence.Request(), {'samples_per_leg': 99999999999})
+    request = fill_message(PlanSequence.Request(), {'samples_per_leg': -1})
+    assert request.samples_per_leg == -1
