@@ -21,6 +21,7 @@ import time
 
 from node_session import planner_session
 import numpy as np
+from punctured_planner.cli import call_service
 
 OBSTACLES = [-2.0, 0.5, 0.0, 0.0, -0.5, 0.0, 2.5, 0.0, 0.0]
 SWEEP = (2, 8, 64, 512, 2048)
@@ -51,15 +52,8 @@ def make_request(rng, k, n, spread=None):
 
 
 def call(executor, client, request, timeout_sec=120.0):
-    """Send request; spin until the response is back; return it (None on timeout)."""
-    future = client.call_async(request)
-    deadline = time.monotonic() + timeout_sec
-    while not future.done():
-        if time.monotonic() > deadline:
-            client.remove_pending_request(future)
-            return None
-        executor.spin_once(timeout_sec=0.05)
-    return future.result()
+    """Send request through the project's client loop; return the response (None on timeout)."""
+    return call_service(executor, client, request, timeout_sec)
 
 
 def measure(executor, client, k, n, calls, seed=1):
