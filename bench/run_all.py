@@ -11,6 +11,7 @@ import datetime
 from importlib import metadata
 import os
 import platform
+import subprocess
 import sys
 import time
 
@@ -113,7 +114,15 @@ def method_lines(settings, seconds):
     ]
 
 
-def write_markdown(figures, outcomes, settings, seconds, stages, profiles):
+def service_sweep(quick):
+    """Return the table bench/service_roundtrip.py prints: round trips over DDS against k."""
+    script = os.path.join(HERE, 'service_roundtrip.py')
+    args = [sys.executable, script] + (['--calls', '50'] if quick else ['--sweep'])
+    result = subprocess.run(args, capture_output=True, text=True, timeout=1800)
+    return result.stdout.strip() or 'failed:\n' + result.stderr.strip()[-2000:]
+
+
+def write_markdown(figures, outcomes, settings, seconds, stages, profiles, service):
     """Write bench/results.md."""
     by = {
         'k': lambda q: q.k, 'kind': lambda q: q.kind, 'd': lambda q: q.d,
@@ -148,6 +157,11 @@ def write_markdown(figures, outcomes, settings, seconds, stages, profiles):
     ]
     for name, text in profiles.items():
         parts += [f'cProfile, {name}:', '', '```', text, '```', '']
+    parts += ['## Service round trip over DDS against k', '',
+              'planner_node in its own process, one client, Fast DDS on this machine '
+              '(`bench/service_roundtrip.py --sweep`); most of the time at large k is '
+              'building and (de)serialising the Path messages, not planning:', '',
+              '```', service, '```', '']
     parts += ['![planning time against k](results.png)', '']
     with open(RESULTS_MD, 'w') as out:
         out.write('\n'.join(parts))
@@ -216,8 +230,10 @@ def main(argv=None):
     profiles = core_speed.profiles()
     print('==> against OMPL and straight lines', file=sys.stderr, flush=True)
     outcomes = peers.run(settings, progress)
+    print('==> service round trip over DDS', file=sys.stderr, flush=True)
+    service = service_sweep(args.quick)
     seconds = time.perf_counter() - start
-    write_markdown(figures, outcomes, settings, seconds, stages, profiles)
+    write_markdown(figures, outcomes, settings, seconds, stages, profiles, service)
     write_plot(figures, outcomes)
     print('\n'.join(headline(figures, outcomes)))
     print()
@@ -226,6 +242,8 @@ def main(argv=None):
     print(format_table(peers.breakdown_rows(outcomes, lambda q: q.k, 'k')))
     print()
     print(format_table([('figure', 'value', 'target')] + core_speed.summary_rows(figures)))
+    print()
+    print(service)
     print(f'\nwrote {RESULTS_MD} and {RESULTS_PNG} in {seconds / 60:.1f} min')
     sys.stdout.flush()
     sys.stderr.flush()
