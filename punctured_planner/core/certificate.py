@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .pairs import pair_difference_matrix, point_pairs
+from .pairs import pair_difference_matrix, point_pairs, with_obstacles
 
 # A clearance is trusted only above this fraction of the coordinate scale: the
 # breakpoints and the closed form each round to a few ulps of the largest
@@ -75,7 +75,7 @@ def segment_minimum(start, velocity):
 def _argmin_over_legs(start, end, legs):
     """Return (distance, leg, pair, fraction) of the smallest segment minimum."""
     squared, fractions = segment_minimum(start, end - start)
-    leg, pair = np.unravel_index(int(np.argmin(squared)), squared.shape)
+    leg, pair = divmod(int(np.argmin(squared)), squared.shape[1])
     return (float(np.sqrt(squared[leg, pair])), int(legs[leg]), int(pair),
             float(fractions[leg, pair]))
 
@@ -155,11 +155,15 @@ def _moving_legs(positions):
     return moving if moving.size else np.array([0])
 
 
-def _closest(positions, obstacles):
-    """Return (distance, leg, first, second, fraction); second >= k names obstacle second - k."""
-    v, k, d = positions.shape
-    r = len(obstacles)
-    points = np.concatenate([positions, np.broadcast_to(obstacles, (v, r, d))], axis=1)
+def _closest(points, k):
+    """
+    Return (distance, leg, first, second, fraction); second >= k names obstacle second - k.
+
+    points is (V, k + r, d): the robots at every breakpoint, then the obstacles.
+    """
+    v, _, d = points.shape
+    r = points.shape[1] - k
+    positions, obstacles = points[:, :k], points[0, k:]
     a, b = point_pairs(k, r)
     if k <= _DIRECT_ROBOTS:
         if a.size * v * d <= _CHUNK_ELEMENTS:
@@ -199,15 +203,16 @@ def certify(times, positions, obstacles):
     (exact), so squared distances neither overflow nor fall into subnormals.
     """
     k, r = positions.shape[1], len(obstacles)
-    scale = coordinate_scale(positions, obstacles)
+    points = with_obstacles(positions, obstacles)
+    scale = float(np.abs(points).max(initial=0.0))
     resolution = RELATIVE_RESOLUTION * scale
     if k == 0 or (k == 1 and r == 0):
         return Clearance(np.inf, 'none', (), 0, 0.0, 0.0, resolution)
     exponent = 0
     if scale > 0 and not _UNSCALED[0] <= scale <= _UNSCALED[1]:
         exponent = int(np.frexp(scale)[1])
-        positions, obstacles = np.ldexp(positions, -exponent), np.ldexp(obstacles, -exponent)
-    distance, leg, first, second, fraction = _closest(positions, obstacles)
+        points = np.ldexp(points, -exponent)
+    distance, leg, first, second, fraction = _closest(points, k)
     distance = float(np.ldexp(distance, exponent))
     tau = float(times[leg] + fraction * (times[leg + 1] - times[leg]))
     if second >= k:

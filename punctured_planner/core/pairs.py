@@ -36,3 +36,12 @@ def pair_difference_matrix(robot_count, obstacle_count=0):
     matrix[np.arange(a.size), b] = -1.0
     matrix.flags.writeable = False
     return matrix
+
+
+def with_obstacles(configurations, obstacles):
+    """Return (n, k + r, d): every configuration's robots followed by the fixed obstacles."""
+    n, k, d = configurations.shape
+    points = np.empty((n, k + len(obstacles), d))
+    points[:, :k] = configurations
+    points[:, k:] = obstacles
+    return points

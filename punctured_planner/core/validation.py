@@ -10,7 +10,7 @@ obstacle at fault.
 import numpy as np
 
 from .errors import ErrorCode, PlanningError
-from .pairs import pair_difference_matrix, point_pairs
+from .pairs import pair_difference_matrix, point_pairs, with_obstacles
 
 # Coordinates beyond this magnitude are refused: squared distances must not
 # overflow, and the certificate's resolution (1e-12 of the scale) stays useful.
@@ -121,7 +121,7 @@ def _coincidences(configurations, obstacles):
     n, k, d = configurations.shape
     r = len(obstacles)
     if k <= _PAIRWISE_ROBOTS:
-        points = np.concatenate([configurations, np.broadcast_to(obstacles, (n, r, d))], axis=1)
+        points = with_obstacles(configurations, obstacles)
         zero = ~(pair_difference_matrix(k, r) @ points).any(axis=2)
         if not zero.any():
             return None, None
