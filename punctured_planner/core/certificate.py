@@ -182,15 +182,14 @@ def _closest(points, k):
     return min(best, found, key=lambda item: item[0])
 
 
-def coordinate_scale(positions, obstacles):
-    """Return the largest coordinate magnitude of the motion and the obstacles."""
-    return max(float(np.abs(positions).max(initial=0.0)),
-               float(np.abs(obstacles).max(initial=0.0)))
+def _scale(points):
+    """Return the largest coordinate magnitude of stacked robots and obstacles."""
+    return float(np.abs(points).max(initial=0.0))
 
 
 def numerical_resolution(positions, obstacles):
     """Return the smallest clearance this motion can certify: RELATIVE_RESOLUTION x scale."""
-    return RELATIVE_RESOLUTION * coordinate_scale(positions, obstacles)
+    return RELATIVE_RESOLUTION * _scale(with_obstacles(positions, obstacles))
 
 
 def certify(times, positions, obstacles):
@@ -204,7 +203,7 @@ def certify(times, positions, obstacles):
     """
     k, r = positions.shape[1], len(obstacles)
     points = with_obstacles(positions, obstacles)
-    scale = float(np.abs(points).max(initial=0.0))
+    scale = _scale(points)
     resolution = RELATIVE_RESOLUTION * scale
     if k == 0 or (k == 1 and r == 0):
         return Clearance(np.inf, 'none', (), 0, 0.0, 0.0, resolution)
