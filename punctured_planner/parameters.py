@@ -15,7 +15,7 @@ import re
 
 import yaml
 
-from .core.space import VARIANTS
+from .core import VARIANTS
 
 NODE_NAME = 'planner_node'
 # Largest samples_per_leg a parameter or a request may ask for.

@@ -24,8 +24,8 @@ import time
 import numpy as np
 
 from . import conversions
-from .core import (ErrorCode, MAX_COORDINATE, PAPER_LEGS, plan as core_plan, PlanningError,
-                   SPREAD_LEGS, Workspace)
+from .core import (ErrorCode, first_out_of_range, MAX_COORDINATE, plan as core_plan,
+                   PlanningError, SCHEDULES, Workspace)
 from .parameters import MAX_SAMPLES_PER_LEG
 
 # Largest |z - plane_z| accepted in planar mode (m).
@@ -265,8 +265,8 @@ class Planner:
         if samples > MAX_SAMPLES_PER_LEG:
             _fail(ErrorCode.REQUEST_OVER_LIMITS, 'samples_per_leg %d is more than %d'
                   % (samples, MAX_SAMPLES_PER_LEG))
-        legs = len(SPREAD_LEGS if settings.variant == 'spread' else PAPER_LEGS)
-        poses = k * ((n - 1) * legs * (samples + 1) + 1)
+        breakpoints = SCHEDULES[settings.variant].breakpoint_count(n)
+        poses = k * ((breakpoints - 1) * (samples + 1) + 1)
         if poses > settings.max_poses:
             _fail(ErrorCode.REQUEST_OVER_LIMITS, 'the answer would hold %d poses (%d robots x '
                   '%d poses), more than max_poses %d' % (poses, k, poses // max(k, 1),
@@ -284,21 +284,19 @@ class Planner:
         """
         d = settings.dimension
         for m, points in enumerate(arrays):
-            values = points[:, :d]
-            far = np.isfinite(values) & (np.abs(values) > MAX_COORDINATE)
-            if far.any():
-                robot, axis = (int(i) for i in np.argwhere(far)[0])
+            far = first_out_of_range(points[:, :d])
+            if far is not None:
+                robot, axis = far
                 _fail(ErrorCode.INVALID_REQUEST, '%s, robot %d: %s = %.6g is beyond the '
                       'supported range +-%.0e' % (label(m), robot, _AXES[axis],
-                                                  float(values[robot, axis]), MAX_COORDINATE),
+                                                  float(points[far]), MAX_COORDINATE),
                       configuration=m, robots=[robot])
-        values = obstacles.points[:, :d]
-        far = np.isfinite(values) & (np.abs(values) > MAX_COORDINATE)
-        if far.any():
-            j, axis = (int(i) for i in np.argwhere(far)[0])
+        far = first_out_of_range(obstacles.points[:, :d])
+        if far is not None:
+            j, axis = far
             _fail(ErrorCode.INVALID_REQUEST, 'obstacle %d (%s): %s = %.6g is beyond the '
                   'supported range +-%.0e' % (j, obstacles.source, _AXES[axis],
-                                              float(values[j, axis]), MAX_COORDINATE),
+                                              float(obstacles.points[far]), MAX_COORDINATE),
                   obstacle=j)
 
     @staticmethod

@@ -11,9 +11,9 @@ lanes and the composition of Remark 2.3), ``plan`` (the plan as breakpoints),
 from .certificate import Clearance
 from .errors import ErrorCode, PlanningError
 from .plan import Plan, plan
-from .sections import PAPER_LEGS, SPREAD_LEGS
+from .sections import Schedule, SCHEDULES, VARIANTS
 from .space import Frame, Workspace
-from .validation import MAX_COORDINATE
+from .validation import first_out_of_range, MAX_COORDINATE
 
-__all__ = ['Clearance', 'ErrorCode', 'Frame', 'MAX_COORDINATE', 'PAPER_LEGS', 'Plan',
-           'PlanningError', 'SPREAD_LEGS', 'Workspace', 'plan']
+__all__ = ['Clearance', 'ErrorCode', 'first_out_of_range', 'Frame', 'MAX_COORDINATE', 'Plan',
+           'PlanningError', 'Schedule', 'SCHEDULES', 'VARIANTS', 'Workspace', 'plan']

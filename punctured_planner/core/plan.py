@@ -18,8 +18,7 @@ from .certificate import certify
 from .complexity import domain_range, sequential_complexity
 from .deformations import desingularize, desingularizing_shift, spread
 from .errors import ErrorCode, PlanningError
-from .sections import (compose, lane_heights, PAPER_FRACTIONS, PAPER_LEGS, segment_times,
-                       SPREAD_FRACTIONS, SPREAD_LEGS)
+from .sections import compose, lane_heights, SCHEDULES, segment_times
 from .strata import epsilon, projection_count, projection_gaps
 from .timing import breakpoint_stamps, resample
 from .validation import validate_configurations
@@ -151,14 +150,12 @@ def plan(workspace, configurations, certify=True):
                                              workspace.min_spacing)
         stages.append(desingularized + (spread_projections - projections)[..., None] * frame.e1)
         projections = spread_projections
-        fractions, legs = SPREAD_FRACTIONS, SPREAD_LEGS
-    else:
-        fractions, legs = PAPER_FRACTIONS, PAPER_LEGS
     stages.append(frame.axis_points(projections))
     lanes = lane_heights(k, r, workspace.lane_spacing, workspace.lane_base, workspace.variant)
     positions = compose(stages, lanes, frame.e2)
-    result = Plan(workspace, configurations, segment_times(n, fractions), positions,
-                  legs * (n - 1), counts, lanes, spacing)
+    schedule = SCHEDULES[workspace.variant]
+    result = Plan(workspace, configurations, segment_times(n, schedule.fractions), positions,
+                  schedule.legs * (n - 1), counts, lanes, spacing)
     if certify:
         _check_required_clearance(result)
     return result

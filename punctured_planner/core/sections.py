@@ -7,6 +7,7 @@ n-th sequential section concatenates Gamma(L_m, L_{m+1}) and, by Remark 2.3,
 wraps each segment in the deformations H(C_m) forward and H(C_{m+1}) backward.
 """
 
+from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
@@ -19,6 +20,26 @@ SPREAD_FRACTIONS = (0.0, 1 / 9, 2 / 9, 1 / 3, 4 / 9, 5 / 9, 2 / 3, 7 / 9, 8 / 9,
 
 PAPER_LEGS = ('D', 'phi', 'lift', 'slide', 'drop', 'phi^-1', 'D^-1')
 SPREAD_LEGS = ('D', 'S', 'phi', 'lift', 'slide', 'drop', 'phi^-1', 'S^-1', 'D^-1')
+
+
+@dataclass(frozen=True)
+class Schedule:
+    """The legs of one segment C_m -> C_{m+1} of a variant and their breakpoint fractions."""
+
+    legs: tuple[str, ...]
+    fractions: tuple[float, ...]
+
+    def breakpoint_count(self, configuration_count: int) -> int:
+        """Return V, the number of breakpoints of a plan through n configurations."""
+        return (configuration_count - 1) * len(self.legs) + 1
+
+
+# The one table from variant to legs: Workspace, plan and the node's limits read it.
+SCHEDULES = {
+    'paper': Schedule(PAPER_LEGS, PAPER_FRACTIONS),
+    'spread': Schedule(SPREAD_LEGS, SPREAD_FRACTIONS),
+}
+VARIANTS = tuple(SCHEDULES)
 
 
 def lane_heights(robot_count, obstacle_count, lane_spacing, lane_base, variant):

@@ -14,9 +14,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import ErrorCode, PlanningError
-from .validation import MAX_COORDINATE
+from .sections import VARIANTS
+from .validation import first_out_of_range, MAX_COORDINATE
 
-VARIANTS = ('paper', 'spread')
 _ORTHONORMAL_TOLERANCE = 1e-9
 
 
@@ -139,11 +139,11 @@ class Workspace:
             raise PlanningError(ErrorCode.NON_FINITE_VALUE,
                                 f'obstacle {bad[0][0]} has a non-finite coordinate',
                                 obstacle=int(bad[0][0]))
-        far = np.argwhere(np.abs(obstacles) > MAX_COORDINATE)
-        if far.size:
+        far = first_out_of_range(obstacles)
+        if far is not None:
             raise PlanningError(ErrorCode.INVALID_REQUEST,
-                                f'obstacle {far[0][0]} is beyond the supported range '
-                                f'+-{MAX_COORDINATE:.0e}', obstacle=int(far[0][0]))
+                                f'obstacle {far[0]} is beyond the supported range '
+                                f'+-{MAX_COORDINATE:.0e}', obstacle=far[0])
         self._check_options(variant, lane_spacing, min_spacing, required_clearance)
         self.obstacles = obstacles
         self.variant = variant

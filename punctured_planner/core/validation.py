@@ -31,6 +31,21 @@ def _real_array(item, what):
                             f'{what} is not an array of real numbers: {error}') from None
 
 
+def first_out_of_range(values: np.ndarray) -> tuple[int, ...] | None:
+    """
+    Return the index of the first finite coordinate beyond +-MAX_COORDINATE, or None.
+
+    The one range rule of the package: every layer finds its offender here and
+    words its own message. Non-finite values are not out of range (they have
+    their own code, NON_FINITE_VALUE).
+    """
+    values = np.asarray(values)
+    if (np.abs(values) <= MAX_COORDINATE).all():
+        return None
+    far = np.argwhere(np.isfinite(values) & (np.abs(values) > MAX_COORDINATE))
+    return tuple(int(i) for i in far[0]) if far.size else None
+
+
 def _reject_out_of_range(configurations, first=0):
     """
     Raise INVALID_REQUEST for a finite coordinate beyond +-MAX_COORDINATE.
@@ -40,10 +55,9 @@ def _reject_out_of_range(configurations, first=0):
     """
     if (np.abs(configurations) <= MAX_COORDINATE).all():
         return True
-    too_far = np.isfinite(configurations) & (np.abs(configurations) > MAX_COORDINATE)
-    if not too_far.any():
+    where = first_out_of_range(configurations)
+    if where is None:
         return False
-    where = tuple(int(i) for i in np.argwhere(too_far)[0])
     m, robot, axis = (0, *where) if configurations.ndim == 2 else where
     raise PlanningError(ErrorCode.INVALID_REQUEST,
                         f'configuration {first + m}, robot {robot}: coordinate {axis} is '
