@@ -246,16 +246,10 @@ def plan_markers(plan, frame_id, stamp_ns, plane_z=0.0, names=None):
     if len(obstacles):
         markers.append(marker('obstacles', 0, Marker.SPHERE_LIST,
                               ColorRGBA(r=0.0, g=0.0, b=0.0, a=1.0), 0.25 * scale, obstacles))
-    frame = plan.frame
-    projections = np.asarray(frame.project(plan.positions)).ravel()
-    low, high = float(projections.min()) - scale, float(projections.max()) + scale
-    axis = to_xyz(frame.axis_points(np.array([low, high])), plane_z)
+    axis = to_xyz(plan.axis_segment(), plane_z)
     markers.append(marker('axis', 0, Marker.LINE_STRIP,
                           ColorRGBA(r=0.5, g=0.5, b=0.5, a=0.8), width, axis))
-    ends = frame.axis_points(np.array([low, high]))
-    heights = np.asarray(plan.lanes, dtype=float)
-    lanes = to_xyz(ends[None, :, :] + heights[:, None, None] * frame.e2,
-                   plane_z).reshape(-1, 3)
+    lanes = to_xyz(plan.lane_segments(), plane_z).reshape(-1, 3)
     markers.append(marker('lanes', 0, Marker.LINE_LIST,
                           ColorRGBA(r=0.6, g=0.6, b=0.6, a=0.5), 0.5 * width, lanes))
     for i in range(k):

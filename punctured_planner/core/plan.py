@@ -96,6 +96,23 @@ class Plan:
             separation /= k + self.workspace.obstacle_count
         return float(min(separation, self._spacing.min(), self.workspace.lane_spacing))
 
+    def axis_segment(self, margin=0.08):
+        """
+        Return the (2, d) end points of the part of the axis o + s e1 a picture shows.
+
+        It covers every robot's and every obstacle's projection, with margin
+        times their spread (at least 1) beyond each end.
+        """
+        values = np.concatenate([self.frame.project(self.positions).ravel(),
+                                 self.workspace.obstacle_projections])
+        low, high = float(values.min()), float(values.max())
+        pad = margin * max(high - low, 1.0)
+        return self.frame.axis_points(np.array([low - pad, high + pad]))
+
+    def lane_segments(self, margin=0.08):
+        """Return the (k, 2, d) end points of the lanes: the axis segment lifted by each lane."""
+        return self.axis_segment(margin)[None] + self.lanes[:, None, None] * self.frame.e2
+
     def position(self, tau):
         """Return the robot positions at parameter(s) tau in [0, 1]: (k, d) or (..., k, d)."""
         tau = np.asarray(tau, dtype=float)

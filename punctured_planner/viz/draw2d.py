@@ -9,8 +9,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import FancyArrowPatch
 import numpy as np
 
-from .geometry import (axis_segment, closest_approach, extent, lane_segments, moving_legs,
-                       waypoints)
+from .geometry import closest_approach, extent, moving_legs, waypoints
 
 AXIS_COLOUR = '0.35'
 CLEARANCE_COLOUR = 'crimson'
@@ -19,9 +18,9 @@ ARROW_MIN_FRACTION = 0.03
 
 def draw_frame_lines(ax, plan, view, colours):
     """Draw the e1 axis (solid grey) and each robot's lane (dashed, in the robot's colour)."""
-    axis = view(axis_segment(plan))
+    axis = view(plan.axis_segment())
     ax.plot(axis[:, 0], axis[:, 1], color=AXIS_COLOUR, lw=1.2, zorder=1)
-    for lane, colour in zip(view(lane_segments(plan)), colours):
+    for lane, colour in zip(view(plan.lane_segments()), colours):
         ax.plot(lane[:, 0], lane[:, 1], ls='--', lw=0.8, color=colour, alpha=0.55, zorder=1)
 
 

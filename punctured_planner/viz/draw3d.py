@@ -3,8 +3,7 @@
 import numpy as np
 
 from .draw2d import AXIS_COLOUR, CLEARANCE_COLOUR
-from .geometry import (axis_segment, closest_approach, extent, lane_segments, moving_legs,
-                       waypoints)
+from .geometry import closest_approach, extent, moving_legs, waypoints
 
 ARROW_MIN_FRACTION = 0.04
 
@@ -26,9 +25,9 @@ def draw_paths_3d(ax, plan, colours, alpha=1.0, arrows=True):
 
 def draw_plan_3d(ax, plan, colours, path_alpha=1.0, arrows=True):
     """Draw axis, lanes, paths, obstacles, numbered waypoints and the closest approach."""
-    axis = axis_segment(plan)
+    axis = plan.axis_segment()
     ax.plot(*axis.T, color=AXIS_COLOUR, lw=1.2)
-    for lane, colour in zip(lane_segments(plan), colours):
+    for lane, colour in zip(plan.lane_segments(), colours):
         ax.plot(*lane.T, ls='--', lw=0.8, color=colour, alpha=0.55)
     draw_paths_3d(ax, plan, colours, alpha=path_alpha, arrows=arrows)
     obstacles = plan.workspace.obstacles

@@ -36,26 +36,6 @@ def plane_view(plan):
     return PlaneView(frame.origin, frame.e1, frame.e2, ('e1', 'e2'))
 
 
-def axis_span(plan, margin=0.08):
-    """Return (low, high) e1 coordinates covering every robot and obstacle, with a margin."""
-    values = np.concatenate([plan.frame.project(plan.positions).ravel(),
-                             plan.frame.project(plan.workspace.obstacles).ravel()])
-    low, high = float(values.min()), float(values.max())
-    pad = margin * max(high - low, 1.0)
-    return low - pad, high + pad
-
-
-def axis_segment(plan):
-    """Return the (2, d) end points of the drawn part of the e1 axis o + s e1."""
-    return plan.frame.axis_points(np.array(axis_span(plan)))
-
-
-def lane_segments(plan):
-    """Return the (k, 2, d) end points of the lanes: the axis lifted by each lane height."""
-    axis = axis_segment(plan)
-    return axis[None] + plan.lanes[:, None, None] * plan.frame.e2
-
-
 def waypoints(plan):
     """Return the (n, k, d) configurations C_1..C_n as they sit in the plan."""
     return plan.positions[plan.waypoint_indices]
