@@ -1,4 +1,4 @@
-"""The paper variant reproduces the paper's construction exactly (design.md section 4)."""
+"""The paper variant reproduces the paper's construction exactly (doc/design.md section 3)."""
 
 from fractions import Fraction
 
@@ -13,7 +13,7 @@ WORKED_REQUEST = [[[0.5, 1.0], [0.5, -2.0]], [[3.0, 0.5], [-1.0, 2.0]]]
 
 
 def test_worked_example_breakpoints_exactly():
-    """shared/examples/paper-worked-example.md, breakpoint by breakpoint."""
+    """The worked example of doc/design.md section 10, breakpoint by breakpoint."""
     p = plan(Workspace(WORKED_OBSTACLES), WORKED_REQUEST)
     expected = np.array([
         [[0.5, 1], [0.5, -2]], [[0.75, 1], [0.875, -2]], [[0.75, 0], [0.875, 0]],
@@ -132,7 +132,10 @@ def test_caller_frame_is_used():
     p = plan(ws, [[[0.3, 2.0]], [[2.0, -1.0]]])
     axis_point = p.positions[2, 0]
     assert abs(axis_point @ np.array([-s, c])) < 1e-12
-    assert p.frame is ws.frame
+    # The lane runs along the rotated e1, at its height along the rotated e2.
+    lifted, slid = p.positions[3, 0], p.positions[4, 0]
+    assert abs((slid - lifted) @ np.array([-s, c])) < 1e-12
+    assert lifted @ np.array([-s, c]) == pytest.approx(p.lanes[0])
 
 
 @pytest.mark.parametrize('request_, code, words', [

@@ -72,8 +72,24 @@ def test_certified_clearance_never_below_the_bound(request):
         return
     assert p.clearance_bound > 0
     assert p.min_clearance >= p.clearance_bound * (1 - 1e-12)
-    k, r = configurations.shape[1], len(obstacles)
-    assert p.clearance_bound >= min(p.input_separation / (k + r), p._spacing.min(), 1.0)
+
+
+@PROPERTY
+@given(requests())
+def test_spread_configurations_keep_the_bound_on_the_axis(request):
+    """After S every robot's projection is at least the bound from every other point's."""
+    obstacles, configurations, _ = request
+    d = obstacles.shape[1]
+    p = plan(Workspace(obstacles, dimension=d, variant='spread', min_spacing=0.5),
+             configurations, certify=False)
+    legs = p.legs_per_segment
+    spread_stages = [v for v in range(len(p.positions)) if v % legs in (2, legs - 2)]
+    projections = p.frame.project(p.positions[spread_stages])
+    points = np.concatenate([projections, np.broadcast_to(
+        p.workspace.obstacle_projections, (len(spread_stages), len(obstacles)))], axis=1)
+    gaps = np.diff(np.sort(points, axis=1), axis=1)
+    if gaps.size:
+        assert gaps.min() >= p.clearance_bound * (1 - 1e-9)
 
 
 def test_required_clearance_refuses_with_pair_leg_and_distance():

@@ -34,7 +34,7 @@ import hypothesis.extra.numpy as hnp
 from motion_check import assert_certificate_agrees, exact_minimum, UNIT_ROUNDOFF
 import numpy as np
 from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
-from punctured_planner.core.certificate import numerical_resolution
+from punctured_planner.core.certificate import RELATIVE_RESOLUTION
 from punctured_planner.core.validation import MAX_COORDINATE
 import pytest
 
@@ -222,14 +222,20 @@ def assert_valid_plan(p, ws, configurations):
         assert ws.obstacle_count == 0 and configurations.shape[1] == 1
         return
     assert clearance >= ws.required_clearance
-    assert clearance > numerical_resolution(p.positions, ws.obstacles)
+    assert clearance > resolution_of(p.positions, ws.obstacles)
     assert_certificate_agrees(p.positions, ws.obstacles, clearance)
+
+
+def resolution_of(positions, obstacles):
+    """Return the documented resolution: 1e-12 of the largest coordinate of the motion."""
+    return RELATIVE_RESOLUTION * max(np.abs(positions).max(initial=0.0),
+                                     np.abs(obstacles).max(initial=0.0))
 
 
 def assert_refusal_is_honest(ws, configurations, error):
     """Check a CLEARANCE_BELOW_REQUIRED refusal: the exact clearance really is too small."""
     uncertified = plan(ws, configurations, certify=False)
-    resolution = numerical_resolution(uncertified.positions, ws.obstacles)
+    resolution = resolution_of(uncertified.positions, ws.obstacles)
     limit = max(ws.required_clearance, resolution)
     squared, where = exact_minimum(uncertified.positions, ws.obstacles,
                                    uncertified.min_clearance)

@@ -3,9 +3,11 @@ ROS-free math core: the sequential planner of Ipanaque Zapata & González, numpy
 
 One module per idea of the paper: ``space`` (the space and its frame),
 ``strata`` (cp and eps), ``deformations`` (D, S, phi), ``sections`` (Gamma,
-lanes and the composition of Remark 2.3), ``plan`` (the plan as breakpoints),
-``certificate`` (exact clearance), ``timing`` (time parameterisation),
-``complexity`` (domains and TC_n), ``validation`` and ``errors``.
+lanes, the composition of Remark 2.3 and the variant table), ``plan`` (the
+plan as breakpoints), ``certificate`` (exact clearance), ``timing`` (time
+parameterisation), ``complexity`` (domains and TC_n), ``pairs`` (index arrays
+of point pairs), ``validation`` and ``errors``. The design, with the proofs,
+is doc/design.md.
 """
 
 from .certificate import Clearance

@@ -5,7 +5,7 @@ Between two breakpoints every robot moves linearly, so the relative position
 of two robots (or of a robot and a fixed obstacle) is r(t) = r0 + t v on
 t in [0, 1] and its minimum norm is reached at t* = clip(-<r0, v> / <v, v>, 0, 1).
 Evaluating that closed form for every leg and every pair gives the exact
-minimum distance over the whole motion (design.md section 2), not a sample.
+minimum distance over the whole motion (doc/design.md section 9), not a sample.
 
 For many robots the pairs are pruned first, exactly: the closest pair over
 all breakpoints gives an upper bound U on the answer, and a pair whose
@@ -53,7 +53,7 @@ class Clearance:
     resolution: float = 0.0
 
 
-def segment_minimum(start, velocity):
+def segment_minimum(start: np.ndarray, velocity: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """
     Return (min squared distance, t*) of |start + t velocity| over t in [0, 1], elementwise.
 
@@ -187,12 +187,7 @@ def _scale(points):
     return float(np.abs(points).max(initial=0.0))
 
 
-def numerical_resolution(positions, obstacles):
-    """Return the smallest clearance this motion can certify: RELATIVE_RESOLUTION x scale."""
-    return RELATIVE_RESOLUTION * _scale(with_obstacles(positions, obstacles))
-
-
-def certify(times, positions, obstacles):
+def certify(times: np.ndarray, positions: np.ndarray, obstacles: np.ndarray) -> Clearance:
     """
     Return the Clearance of the motion through breakpoints (times (V,), positions (V, k, d)).
 

@@ -7,13 +7,15 @@ nk + 1 domains for r >= 1 and n(k - 1) + 1 for r = 0.
 """
 
 
-def domain_range(configuration_count, robot_count, obstacle_count):
+def domain_range(configuration_count: int, robot_count: int,
+                 obstacle_count: int) -> tuple[int, int]:
     """Return the smallest and largest domain value l = sum of cp(C_m)."""
     n, k, r = configuration_count, robot_count, obstacle_count
     return n * max(r, 1), n * (k + r)
 
 
-def sequential_complexity(configuration_count, robot_count, obstacle_count, dimension):
+def sequential_complexity(configuration_count: int, robot_count: int, obstacle_count: int,
+                          dimension: int) -> int:
     """
     Return TC_n(F(R^d - Q_r, k)), non-reduced (paper, Theorem 1.1, González–Grant).
 

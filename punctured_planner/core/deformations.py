@@ -3,13 +3,14 @@ The deformations that carry any configuration onto the axis: D, S and phi.
 
 * D, the desingularisation (paper, Section 3): robot with paper index j = r + i
   (i = 1..k) moves by t (j - 1) eps(C) e1; only for cp(C) < k + r.
-* S, our spreading leg (design.md section 3, variant 'spread'): robots move
+* S, our spreading leg (doc/design.md section 5, variant 'spread'): robots move
   along e1 only, keeping their order and their interval between obstacle
   projections, to the nearest positions that are `min_spacing` apart.
 * phi, the projection onto the axis (paper, equation (3.2)): x + t (p(x) e1 - x).
 """
 
 import numpy as np
+import numpy.typing as npt
 
 try:
     from scipy.optimize import isotonic_regression
@@ -17,7 +18,7 @@ except ImportError:  # SciPy < 1.12: Ubuntu 24.04's python3-scipy (ROS 2 Jazzy) 
     isotonic_regression = None
 
 
-def pool_adjacent_violators(values):
+def pool_adjacent_violators(values: npt.ArrayLike) -> np.ndarray:
     """
     Return the non-decreasing least-squares fit of values (unit weights).
 
@@ -35,21 +36,22 @@ def pool_adjacent_violators(values):
     return np.repeat(means, counts)
 
 
-def isotonic_fit(values):
+def isotonic_fit(values: np.ndarray) -> np.ndarray:
     """Return the non-decreasing least-squares fit of values: SciPy's, or the fallback."""
     if isotonic_regression is None:
         return pool_adjacent_violators(values)
     return isotonic_regression(values).x
 
 
-def desingularizing_shift(projection_counts, eps, robot_count, obstacle_count):
+def desingularizing_shift(projection_counts: np.ndarray, eps: np.ndarray, robot_count: int,
+                          obstacle_count: int) -> np.ndarray:
     """Return the (n, k) e1 shift of D(C, 1): (j - 1) eps(C) for paper index j, 0 in A_{k+r}."""
     indices = obstacle_count + np.arange(robot_count)
     singular = projection_counts < robot_count + obstacle_count
     return np.where(singular[:, None], indices[None, :] * eps[:, None], 0.0)
 
 
-def desingularize(configurations, shift, e1):
+def desingularize(configurations: np.ndarray, shift: np.ndarray, e1: np.ndarray) -> np.ndarray:
     """Return D(C, 1) = C + shift e1 for configurations (n, k, d) and shifts (n, k)."""
     return configurations + shift[..., None] * e1
 
@@ -60,7 +62,8 @@ def _interval_spacing(lengths, counts, min_spacing):
         return np.minimum(min_spacing, lengths / (counts + 1))
 
 
-def spread(projections, sorted_obstacle_projections, min_spacing):
+def spread(projections: np.ndarray, sorted_obstacle_projections: np.ndarray,
+           min_spacing: float) -> tuple[np.ndarray, np.ndarray]:
     """
     Return S(C, 1) projections: the nearest order-preserving spaced positions.
 

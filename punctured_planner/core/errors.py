@@ -1,6 +1,8 @@
 """Planning errors: a machine-readable code plus the culprit, Nav2 style."""
 
+from collections.abc import Iterable
 import enum
+from typing import Any
 
 
 class ErrorCode(enum.IntEnum):
@@ -35,8 +37,9 @@ class PlanningError(ValueError):
     indices involved, ``obstacle`` the obstacle index (or None).
     """
 
-    def __init__(self, code, message, configuration=None, robots=(), obstacle=None,
-                 clearance=None):
+    def __init__(self, code: int, message: str, configuration: int | None = None,
+                 robots: Iterable[int] = (), obstacle: int | None = None,
+                 clearance: Any = None) -> None:
         """Store the code and the culprit; the message is the human-readable reason."""
         super().__init__(message)
         self.code = ErrorCode(code)
@@ -46,6 +49,6 @@ class PlanningError(ValueError):
         # The refused plan's Clearance certificate (CLEARANCE_BELOW_REQUIRED only).
         self.clearance = clearance
 
-    def __str__(self):
+    def __str__(self) -> str:
         """Return the message prefixed by the code name."""
         return f'{self.code.name}: {self.args[0]}'

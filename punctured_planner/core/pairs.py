@@ -6,7 +6,7 @@ import numpy as np
 
 
 @lru_cache(maxsize=32)
-def point_pairs(robot_count, obstacle_count=0):
+def point_pairs(robot_count: int, obstacle_count: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """
     Return read-only index arrays (a, b) into the k + r points of a configuration.
 
@@ -22,7 +22,7 @@ def point_pairs(robot_count, obstacle_count=0):
 
 
 @lru_cache(maxsize=32)
-def pair_difference_matrix(robot_count, obstacle_count=0):
+def pair_difference_matrix(robot_count: int, obstacle_count: int = 0) -> np.ndarray:
     """
     Return the (pairs, k + r) matrix with rows e_a - e_b for the pairs of point_pairs.
 
@@ -38,7 +38,7 @@ def pair_difference_matrix(robot_count, obstacle_count=0):
     return matrix
 
 
-def with_obstacles(configurations, obstacles):
+def with_obstacles(configurations: np.ndarray, obstacles: np.ndarray) -> np.ndarray:
     """Return (n, k + r, d): every configuration's robots followed by the fixed obstacles."""
     n, k, d = configurations.shape
     points = np.empty((n, k + len(obstacles), d))

@@ -12,13 +12,15 @@ interpolation of its breakpoints, stored exactly.
 from functools import cached_property
 
 import numpy as np
+import numpy.typing as npt
 from scipy.spatial import cKDTree
 
-from .certificate import certify
+from .certificate import certify, Clearance
 from .complexity import domain_range, sequential_complexity
 from .deformations import desingularize, desingularizing_shift, spread
 from .errors import ErrorCode, PlanningError
 from .sections import compose, lane_heights, SCHEDULES, segment_times
+from .space import Workspace
 from .strata import epsilon, projection_count, projection_gaps
 from .timing import breakpoint_stamps, resample
 from .validation import validate_configurations
@@ -27,8 +29,9 @@ from .validation import validate_configurations
 class Plan:
     """A synchronous collision-free motion through C_1..C_n, stored as breakpoints."""
 
-    def __init__(self, workspace, configurations, times, positions, leg_names,
-                 projection_counts, lanes, spacing):
+    def __init__(self, workspace: Workspace, configurations: np.ndarray, times: np.ndarray,
+                 positions: np.ndarray, leg_names: tuple[str, ...],
+                 projection_counts: np.ndarray, lanes: np.ndarray, spacing: np.ndarray) -> None:
         """Keep the breakpoints and the data the derived attributes need."""
         n, k, d = configurations.shape
         r = workspace.obstacle_count
@@ -53,17 +56,17 @@ class Plan:
         self._spacing = spacing
 
     @cached_property
-    def clearance(self):
+    def clearance(self) -> Clearance:
         """Return the exact Clearance certificate (computed once, on first use)."""
         return certify(self.times, self.positions, self.workspace.obstacles)
 
     @property
-    def min_clearance(self):
+    def min_clearance(self) -> float:
         """Return the exact minimum distance over all robot and robot-obstacle pairs."""
         return self.clearance.distance
 
     @cached_property
-    def input_separation(self):
+    def input_separation(self) -> float:
         """Return the smallest robot-robot or robot-obstacle distance in any C_m."""
         obstacles = self.workspace.obstacles
         smallest = np.inf
@@ -76,7 +79,7 @@ class Plan:
         return float(smallest)
 
     @cached_property
-    def clearance_bound(self):
+    def clearance_bound(self) -> float | None:
         """
         Return a lower bound on min_clearance for the 'spread' variant (None for 'paper').
 
@@ -96,7 +99,7 @@ class Plan:
             separation /= k + self.workspace.obstacle_count
         return float(min(separation, self._spacing.min(), self.workspace.lane_spacing))
 
-    def axis_segment(self, margin=0.08):
+    def axis_segment(self, margin: float = 0.08) -> np.ndarray:
         """
         Return the (2, d) end points of the part of the axis o + s e1 a picture shows.
 
@@ -109,11 +112,11 @@ class Plan:
         pad = margin * max(high - low, 1.0)
         return self.frame.axis_points(np.array([low - pad, high + pad]))
 
-    def lane_segments(self, margin=0.08):
+    def lane_segments(self, margin: float = 0.08) -> np.ndarray:
         """Return the (k, 2, d) end points of the lanes: the axis segment lifted by each lane."""
         return self.axis_segment(margin)[None] + self.lanes[:, None, None] * self.frame.e2
 
-    def position(self, tau):
+    def position(self, tau: npt.ArrayLike) -> np.ndarray:
         """Return the robot positions at parameter(s) tau in [0, 1]: (k, d) or (..., k, d)."""
         tau = np.asarray(tau, dtype=float)
         leg = np.clip(np.searchsorted(self.times, tau, side='right') - 1, 0, self.times.size - 2)
@@ -124,15 +127,16 @@ class Plan:
         # (1 - f) a + f b, not a + f (b - a): exact at both ends of every leg.
         return (1.0 - fraction) * self.positions[leg] + fraction * self.positions[leg + 1]
 
-    def stamps(self, max_speed):
+    def stamps(self, max_speed: float) -> np.ndarray:
         """Return (V,) seconds from the start at each breakpoint, fastest robot at max_speed."""
         return breakpoint_stamps(self.positions, max_speed)
 
-    def duration(self, max_speed):
+    def duration(self, max_speed: float) -> float:
         """Return the duration in seconds of the whole motion at max_speed."""
         return float(self.stamps(max_speed)[-1])
 
-    def sample(self, samples_per_leg, max_speed=None):
+    def sample(self, samples_per_leg: int, max_speed: float | None = None
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """
         Return (values, positions, is_breakpoint) with extra samples inside every leg.
 
@@ -142,7 +146,7 @@ class Plan:
         return resample(values, self.positions, samples_per_leg)
 
 
-def plan(workspace, configurations, certify=True):
+def plan(workspace: Workspace, configurations: npt.ArrayLike, certify: bool = True) -> Plan:
     """
     Return the Plan through configurations (n, k, d) in workspace, or raise PlanningError.
 

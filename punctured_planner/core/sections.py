@@ -42,7 +42,8 @@ SCHEDULES = {
 VARIANTS = tuple(SCHEDULES)
 
 
-def lane_heights(robot_count, obstacle_count, lane_spacing, lane_base, variant):
+def lane_heights(robot_count: int, obstacle_count: int, lane_spacing: float, lane_base: float,
+                 variant: str) -> np.ndarray:
     """
     Return the (k,) e2 heights of the lanes above the axis.
 
@@ -57,7 +58,7 @@ def lane_heights(robot_count, obstacle_count, lane_spacing, lane_base, variant):
 
 
 @lru_cache(maxsize=64)
-def segment_times(configuration_count, fractions):
+def segment_times(configuration_count: int, fractions: tuple[float, ...]) -> np.ndarray:
     """
     Return breakpoint parameters: tau_m + (tau_{m+1} - tau_m) f for each segment.
 
@@ -71,7 +72,8 @@ def segment_times(configuration_count, fractions):
     return times
 
 
-def compose(deformation_stages, lanes, e2):
+def compose(deformation_stages: list[np.ndarray], lanes: np.ndarray,
+            e2: np.ndarray) -> np.ndarray:
     """
     Return the (V, k, d) breakpoint positions of the sequential section.
 

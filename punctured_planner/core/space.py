@@ -5,13 +5,14 @@ The paper normalises the obstacles onto the e1 axis and writes p(x) for the
 first coordinate (Section 3). For arbitrary obstacles we pick a frame in which
 the obstacles' e1 projections are pairwise distinct; robots project onto the
 line o + R e1 and the lanes lie beyond every obstacle's e2 offset
-(design.md section 3). The frame is fixed per workspace, never per query, so
+(doc/design.md section 4). The frame is fixed per workspace, never per query, so
 the domains of continuity are well defined.
 """
 
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
 from .errors import ErrorCode, PlanningError
 from .sections import VARIANTS
@@ -20,23 +21,28 @@ from .validation import first_out_of_range, MAX_COORDINATE
 _ORTHONORMAL_TOLERANCE = 1e-9
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Frame:
-    """Origin o and orthonormal directions e1 (projection axis), e2 (lane direction)."""
+    """
+    Origin o and orthonormal directions e1 (projection axis), e2 (lane direction).
+
+    Compared by identity (eq=False): its fields are numpy arrays, whose == is
+    elementwise; a workspace's frame is one object for all its plans.
+    """
 
     origin: np.ndarray
     e1: np.ndarray
     e2: np.ndarray
 
-    def project(self, points):
+    def project(self, points: npt.ArrayLike) -> np.ndarray:
         """Return p(x) = <x - o, e1> for points of shape (..., d)."""
         return (np.asarray(points, dtype=float) - self.origin) @ self.e1
 
-    def offset(self, points):
+    def offset(self, points: npt.ArrayLike) -> np.ndarray:
         """Return the e2 offset <x - o, e2> for points of shape (..., d)."""
         return (np.asarray(points, dtype=float) - self.origin) @ self.e2
 
-    def axis_points(self, projections):
+    def axis_points(self, projections: npt.ArrayLike) -> np.ndarray:
         """Return o + p e1 for projections of shape (...,): the points of the axis."""
         return self.origin + np.asarray(projections, dtype=float)[..., None] * self.e1
 
@@ -72,7 +78,7 @@ def _moment_curve_directions(dimension, count):
     return directions / np.linalg.norm(directions, axis=1, keepdims=True)
 
 
-def choose_frame(obstacles):
+def choose_frame(obstacles: np.ndarray) -> Frame:
     """
     Return the default frame for obstacles (r, d): deterministic, fixed per obstacle set.
 
@@ -119,8 +125,10 @@ class Workspace:
     ``required_clearance`` refuses plans whose certified clearance is below it.
     """
 
-    def __init__(self, obstacles, dimension=None, frame=None, lane_spacing=1.0,
-                 variant='paper', min_spacing=0.5, required_clearance=0.0):
+    def __init__(self, obstacles: npt.ArrayLike, dimension: int | None = None,
+                 frame: Frame | tuple | None = None, lane_spacing: float = 1.0,
+                 variant: str = 'paper', min_spacing: float = 0.5,
+                 required_clearance: float = 0.0) -> None:
         """Validate the obstacles and options and fix the frame."""
         obstacles = np.asarray(obstacles, dtype=float)
         if obstacles.size == 0:
@@ -191,6 +199,6 @@ class Workspace:
                                 'required_clearance must be non-negative')
 
     @property
-    def obstacle_count(self):
+    def obstacle_count(self) -> int:
         """Return r, the number of obstacles."""
         return len(self.obstacles)

@@ -8,7 +8,8 @@ values of p over q_1..q_r, x_1..x_k, so r <= cp(C) <= k + r (at least 1 when r =
 import numpy as np
 
 
-def all_projections(robot_projections, obstacle_projections):
+def all_projections(robot_projections: np.ndarray,
+                    obstacle_projections: np.ndarray) -> np.ndarray:
     """Return (..., r + k) projections in the paper's numbering: obstacles first, then robots."""
     k = robot_projections.shape[-1]
     r = obstacle_projections.size
@@ -18,7 +19,8 @@ def all_projections(robot_projections, obstacle_projections):
     return points
 
 
-def projection_gaps(robot_projections, obstacle_projections):
+def projection_gaps(robot_projections: np.ndarray,
+                    obstacle_projections: np.ndarray) -> np.ndarray:
     """
     Return the (..., k + r - 1) gaps between consecutive sorted projections of each C_m.
 
@@ -28,7 +30,7 @@ def projection_gaps(robot_projections, obstacle_projections):
     return ordered[..., 1:] - ordered[..., :-1]
 
 
-def projection_count(gaps):
+def projection_count(gaps: np.ndarray) -> np.ndarray:
     """
     Return cp(C_m) for each configuration: distinct projections among all k + r points.
 
@@ -37,7 +39,7 @@ def projection_count(gaps):
     return 1 + np.count_nonzero(gaps > 0, axis=-1)
 
 
-def epsilon(gaps, fallback):
+def epsilon(gaps: np.ndarray, fallback: float) -> np.ndarray:
     """
     Return eps(C_m) = min{|p(a) - p(b)| : p(a) != p(b)} / (k + r) for each configuration.
 

@@ -1,14 +1,15 @@
 """
-Time parameterisation of a synchronous piecewise-linear motion (design.md section 3).
+Time parameterisation of a synchronous piecewise-linear motion (doc/design.md section 8).
 
 Any reparameterisation common to all robots keeps the motion collision-free,
 so each leg gets the duration that lets its fastest robot move at max_speed.
 """
 
 import numpy as np
+import numpy.typing as npt
 
 
-def leg_lengths(positions):
+def leg_lengths(positions: np.ndarray) -> np.ndarray:
     """Return the (V - 1,) largest robot displacement along each leg."""
     steps = np.diff(positions, axis=0)
     if steps.shape[1] == 0:
@@ -16,14 +17,15 @@ def leg_lengths(positions):
     return np.sqrt(np.einsum('vkd,vkd->vk', steps, steps)).max(axis=1)
 
 
-def breakpoint_stamps(positions, max_speed):
+def breakpoint_stamps(positions: np.ndarray, max_speed: float) -> np.ndarray:
     """Return (V,) seconds from the start at which the robots reach each breakpoint."""
     if not max_speed > 0:
         raise ValueError('max_speed must be positive')
     return np.concatenate([[0.0], np.cumsum(leg_lengths(positions) / max_speed)])
 
 
-def resample(values, positions, samples_per_leg):
+def resample(values: npt.ArrayLike, positions: np.ndarray, samples_per_leg: int
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """
     Insert samples_per_leg evenly spaced samples inside every leg.
 

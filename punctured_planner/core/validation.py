@@ -8,6 +8,7 @@ obstacle at fault.
 """
 
 import numpy as np
+import numpy.typing as npt
 
 from .errors import ErrorCode, PlanningError
 from .pairs import pair_difference_matrix, point_pairs, with_obstacles
@@ -156,7 +157,7 @@ def _coincidences(configurations, obstacles):
     return _sorted_coincidence(configurations), on
 
 
-def validate_configurations(configurations, obstacles):
+def validate_configurations(configurations: npt.ArrayLike, obstacles: np.ndarray) -> np.ndarray:
     """Return the request as a float (n, k, d) array after every check, or raise PlanningError."""
     configurations, all_finite = _as_array(configurations, obstacles.shape[1])
     if not all_finite:
