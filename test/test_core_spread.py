@@ -82,7 +82,7 @@ def test_spread_configurations_keep_the_bound_on_the_axis(request):
     d = obstacles.shape[1]
     p = plan(Workspace(obstacles, dimension=d, variant='spread', min_spacing=0.5),
              configurations, certify=False)
-    legs = p.legs_per_segment
+    legs = int(p.waypoint_indices[1])
     spread_stages = [v for v in range(len(p.positions)) if v % legs in (2, legs - 2)]
     projections = p.frame.project(p.positions[spread_stages])
     points = np.concatenate([projections, np.broadcast_to(

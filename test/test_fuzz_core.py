@@ -419,7 +419,10 @@ def malformed_workspaces(draw):
     elif fault == 'mismatch':
         options['dimension'] = d + 1
     elif fault == 'undimensioned' and not len(obstacles):
+        # A (0, d) array still gives d; a flat empty one cannot.
         del options['dimension']
+        if draw(st.booleans()):
+            obstacles = np.empty(0)
     elif fault in ('lane_spacing', 'min_spacing', 'required_clearance'):
         options[fault] = draw(st.sampled_from([np.nan, np.inf, -1.0] + (
             [] if fault == 'required_clearance' else [0.0])))
@@ -439,6 +442,8 @@ def test_malformed_workspaces_raise_a_documented_code_naming_the_obstacle(case):
     d = options.get('dimension')
     empty = obstacles.size == 0
     harmless = ('nan', 'range', 'mismatch', 'duplicate') if empty else ()
+    if fault == 'undimensioned' and obstacles.ndim == 2:
+        d, harmless = obstacles.shape[1], ('undimensioned',)
     valid = d is not None and d >= 2 and (fault == 'none' or fault in harmless)
     try:
         ws = Workspace(obstacles, **options)

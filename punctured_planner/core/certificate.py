@@ -72,30 +72,45 @@ def segment_minimum(start: np.ndarray, velocity: np.ndarray) -> tuple[np.ndarray
     return np.einsum('...i,...i->...', closest, closest), t
 
 
-def _argmin_over_legs(start, end, legs):
-    """Return (distance, leg, pair, fraction) of the smallest segment minimum."""
+def _argmin_over_legs(start, end, legs, offsets=None):
+    """
+    Return (value, leg, pair, fraction) of the smallest segment minimum.
+
+    value is the distance, or with offsets (pairs,) the distance minus the
+    pair's offset (a surface gap): then each pair's own minimum over the legs
+    counts, and the smallest gap may belong to a pair that is not the closest.
+    """
     squared, fractions = segment_minimum(start, end - start)
-    leg, pair = divmod(int(np.argmin(squared)), squared.shape[1])
-    return (float(np.sqrt(squared[leg, pair])), int(legs[leg]), int(pair),
-            float(fractions[leg, pair]))
+    if offsets is None:
+        leg, pair = divmod(int(np.argmin(squared)), squared.shape[1])
+        return (float(np.sqrt(squared[leg, pair])), int(legs[leg]), int(pair),
+                float(fractions[leg, pair]))
+    per_pair_leg = np.argmin(squared, axis=0)
+    pairs = np.arange(squared.shape[1])
+    values = np.sqrt(squared[per_pair_leg, pairs]) - offsets
+    pair = int(np.argmin(values))
+    leg = int(per_pair_leg[pair])
+    return float(values[pair]), int(legs[leg]), pair, float(fractions[leg, pair])
 
 
-def _pairs_minimum(points, legs, a, b):
-    """Return (distance, leg, pair, fraction) of the closest pair (a[i], b[i]) over legs."""
+def _pairs_minimum(points, legs, a, b, offsets=None):
+    """Return (value, leg, pair, fraction) of the closest pair (a[i], b[i]) over legs."""
     best = (np.inf, 0, 0, 0.0)
     step = max(1, _CHUNK_ELEMENTS // max(1, a.size * points.shape[2]))
     for first in range(0, legs.size, step):
         chunk = legs[first:first + step]
         start = points[chunk][:, a] - points[chunk][:, b]
         end = points[chunk + 1][:, a] - points[chunk + 1][:, b]
-        best = min(best, _argmin_over_legs(start, end, chunk), key=lambda item: item[0])
+        best = min(best, _argmin_over_legs(start, end, chunk, offsets),
+                   key=lambda item: item[0])
     return best
 
 
-def _direct_minimum(points, robot_count, obstacle_count):
-    """Return (distance, leg, pair, fraction) over every pair and every leg at once."""
+def _direct_minimum(points, robot_count, obstacle_count, offsets=None):
+    """Return (value, leg, pair, fraction) over every pair and every leg at once."""
     relative = pair_difference_matrix(robot_count, obstacle_count) @ points
-    return _argmin_over_legs(relative[:-1], relative[1:], np.arange(points.shape[0] - 1))
+    return _argmin_over_legs(relative[:-1], relative[1:], np.arange(points.shape[0] - 1),
+                             offsets)
 
 
 def _breakpoint_bound(positions, obstacles):
@@ -104,6 +119,7 @@ def _breakpoint_bound(positions, obstacles):
 
     Any instant's closest pair bounds the minimum; the first and last breakpoint
     and every tenth in between keep the bound tight without a tree per breakpoint.
+    Without obstacles (an empty (0, d) array) it bounds the closest robot pair.
     """
     bound = np.inf
     obstacle_tree = cKDTree(obstacles) if len(obstacles) else None
@@ -155,30 +171,37 @@ def _moving_legs(positions):
     return moving if moving.size else np.array([0])
 
 
-def _closest(points, k):
+def _closest(points, k, radii=None):
     """
-    Return (distance, leg, first, second, fraction); second >= k names obstacle second - k.
+    Return (value, leg, first, second, fraction); second >= k names obstacle second - k.
 
     points is (V, k + r, d): the robots at every breakpoint, then the obstacles.
+    value is the smallest distance or, with radii (k + r,) of the points, the
+    smallest surface gap: distance minus both radii.
     """
     v, _, d = points.shape
     r = points.shape[1] - k
     positions, obstacles = points[:, :k], points[0, k:]
     a, b = point_pairs(k, r)
+    offsets = None if radii is None else radii[a] + radii[b]
     if k <= _DIRECT_ROBOTS:
         if a.size * v * d <= _CHUNK_ELEMENTS:
-            distance, leg, pair, fraction = _direct_minimum(points, k, r)
+            value, leg, pair, fraction = _direct_minimum(points, k, r, offsets)
         else:
-            distance, leg, pair, fraction = _pairs_minimum(points, np.arange(v - 1), a, b)
-        return distance, leg, int(a[pair]), int(b[pair]), fraction
-    # Many robots: every robot-obstacle pair, and the robot pairs the sweep keeps.
+            value, leg, pair, fraction = _pairs_minimum(points, np.arange(v - 1), a, b, offsets)
+        return value, leg, int(a[pair]), int(b[pair]), fraction
+    # Many robots: every robot-obstacle pair, and the robot pairs the sweep keeps. All
+    # robot pairs have one offset (2R), so the closest robot pair has the smallest gap.
     legs = _moving_legs(positions)
     best = (np.inf, 0, 0, 0, 0.0)
     if r:
         a, b = a[a.size - k * r:], b[b.size - k * r:]
-        distance, leg, pair, fraction = _pairs_minimum(points, legs, a, b)
-        best = (distance, leg, int(a[pair]), int(b[pair]), fraction)
-    found = _pruned_robot_minimum(positions, legs, _breakpoint_bound(positions, obstacles))
+        value, leg, pair, fraction = _pairs_minimum(
+            points, legs, a, b, None if offsets is None else offsets[offsets.size - k * r:])
+        best = (value, leg, int(a[pair]), int(b[pair]), fraction)
+    bound = _breakpoint_bound(positions, obstacles if radii is None else obstacles[:0])
+    distance, leg, first, second, fraction = _pruned_robot_minimum(positions, legs, bound)
+    found = (distance - (0.0 if radii is None else 2 * radii[0]), leg, first, second, fraction)
     return min(best, found, key=lambda item: item[0])
 
 
@@ -187,12 +210,15 @@ def _scale(points):
     return float(np.abs(points).max(initial=0.0))
 
 
-def certify(times: np.ndarray, positions: np.ndarray, obstacles: np.ndarray) -> Clearance:
+def certify(times: np.ndarray, positions: np.ndarray, obstacles: np.ndarray,
+            radii: np.ndarray | None = None) -> Clearance:
     """
     Return the Clearance of the motion through breakpoints (times (V,), positions (V, k, d)).
 
     Exact (closed form per leg) over every robot pair and every robot-obstacle
     pair; the pruning for many robots drops only pairs that cannot be closest.
+    With radii (k + r,), robots' then obstacles', the Clearance's distance is
+    the smallest surface gap, |a - b| - radius_a - radius_b, and where it is.
     Far from unit scale the coordinates are first multiplied by a power of two
     (exact), so squared distances neither overflow nor fall into subnormals.
     """
@@ -206,7 +232,8 @@ def certify(times: np.ndarray, positions: np.ndarray, obstacles: np.ndarray) -> 
     if scale > 0 and not _UNSCALED[0] <= scale <= _UNSCALED[1]:
         exponent = int(np.frexp(scale)[1])
         points = np.ldexp(points, -exponent)
-    distance, leg, first, second, fraction = _closest(points, k)
+        radii = None if radii is None else np.ldexp(radii, -exponent)
+    distance, leg, first, second, fraction = _closest(points, k, radii)
     distance = float(np.ldexp(distance, exponent))
     tau = float(times[leg] + fraction * (times[leg + 1] - times[leg]))
     if second >= k:

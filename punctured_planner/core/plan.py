@@ -16,13 +16,14 @@ import numpy.typing as npt
 from scipy.spatial import cKDTree
 
 from .certificate import certify, Clearance
+from . import discs
 from .complexity import domain_range, sequential_complexity
 from .deformations import desingularize, desingularizing_shift, spread
 from .errors import ErrorCode, PlanningError
 from .sections import compose, lane_heights, SCHEDULES, segment_times
 from .space import Workspace
 from .strata import epsilon, projection_count, projection_gaps
-from .timing import breakpoint_stamps, resample
+from .timing import breakpoint_stamps, length_times, resample
 from .validation import validate_configurations
 
 
@@ -31,8 +32,13 @@ class Plan:
 
     def __init__(self, workspace: Workspace, configurations: np.ndarray, times: np.ndarray,
                  positions: np.ndarray, leg_names: tuple[str, ...],
-                 projection_counts: np.ndarray, lanes: np.ndarray, spacing: np.ndarray) -> None:
-        """Keep the breakpoints and the data the derived attributes need."""
+                 projection_counts: np.ndarray, lanes: np.ndarray, spacing: np.ndarray | None,
+                 waypoint_indices: np.ndarray | None = None) -> None:
+        """
+        Keep the breakpoints and the data the derived attributes need.
+
+        waypoint_indices defaults to the same number of legs in every segment.
+        """
         n, k, d = configurations.shape
         r = workspace.obstacle_count
         self.workspace = workspace
@@ -40,8 +46,9 @@ class Plan:
         self.times = times
         self.positions = positions
         self.leg_names = leg_names
-        self.legs_per_segment = len(leg_names) // (n - 1)
-        self.waypoint_indices = np.arange(n) * self.legs_per_segment
+        if waypoint_indices is None:
+            waypoint_indices = np.arange(n) * (len(leg_names) // (n - 1))
+        self.waypoint_indices = waypoint_indices
         self.projection_counts = projection_counts
         self.domain = int(projection_counts.sum())
         low, high = domain_range(n, k, r)
@@ -62,8 +69,32 @@ class Plan:
 
     @property
     def min_clearance(self) -> float:
-        """Return the exact minimum distance over all robot and robot-obstacle pairs."""
+        """Return the exact minimum centre distance over all robot and robot-obstacle pairs."""
         return self.clearance.distance
+
+    @cached_property
+    def gap(self) -> Clearance:
+        """
+        Return the exact surface-gap certificate: its distance is the smallest gap.
+
+        The gap is the centre distance - 2R for two robots and - R - rho_j for a
+        robot and obstacle j; with no radius it is the clearance itself.
+        """
+        workspace = self.workspace
+        if not workspace.has_bodies:
+            return self.clearance
+        k = self.positions.shape[1]
+        radii = np.concatenate([np.full(k, workspace.robot_radius), workspace.obstacle_radii])
+        return certify(self.times, self.positions, workspace.obstacles, radii)
+
+    @property
+    def min_gap(self) -> float:
+        """Return the exact minimum surface gap over the whole motion; negative means contact."""
+        return self.gap.distance
+
+    def segment_of(self, leg: int) -> int:
+        """Return m, 0-based, of the segment C_{m+1} -> C_{m+2} that leg [leg, leg + 1] is in."""
+        return int(np.searchsorted(self.waypoint_indices, leg, side='right')) - 1
 
     @cached_property
     def input_separation(self) -> float:
@@ -150,16 +181,29 @@ def plan(workspace: Workspace, configurations: npt.ArrayLike, certify: bool = Tr
     """
     Return the Plan through configurations (n, k, d) in workspace, or raise PlanningError.
 
-    With certify (the default) the exact clearance is computed at once and a
-    plan below workspace.required_clearance is refused.
+    With certify (the default) the exact certificate is computed at once and a
+    plan below workspace.required_clearance is refused (its gap when robots or
+    obstacles have a radius).
     """
-    configurations = validate_configurations(configurations, workspace.obstacles)
+    configurations = validate_configurations(configurations, workspace.obstacles,
+                                             workspace.robot_radius, workspace.obstacle_radii)
+    projections = workspace.frame.project(configurations)
+    gaps = projection_gaps(projections, workspace.obstacle_projections)
+    counts = projection_count(gaps)
+    if workspace.variant == 'discs':
+        result = _disc_plan(workspace, configurations, counts)
+    else:
+        result = _axis_plan(workspace, configurations, projections, gaps, counts)
+    if certify:
+        _check_required_clearance(result)
+    return result
+
+
+def _axis_plan(workspace, configurations, projections, gaps, counts):
+    """Return the paper's or the spread variant's Plan: D, (S,) phi onto the axis, Gamma."""
     n, k, d = configurations.shape
     r = workspace.obstacle_count
     frame = workspace.frame
-    projections = frame.project(configurations)
-    gaps = projection_gaps(projections, workspace.obstacle_projections)
-    counts = projection_count(gaps)
     eps = epsilon(gaps, workspace.lane_spacing)
     shift = desingularizing_shift(counts, eps, k, r)
     desingularized = desingularize(configurations, shift, frame.e1)
@@ -175,37 +219,50 @@ def plan(workspace: Workspace, configurations: npt.ArrayLike, certify: bool = Tr
     lanes = lane_heights(k, r, workspace.lane_spacing, workspace.lane_base, workspace.variant)
     positions = compose(stages, lanes, frame.e2)
     schedule = SCHEDULES[workspace.variant]
-    result = Plan(workspace, configurations, segment_times(n, schedule.fractions), positions,
-                  schedule.legs * (n - 1), counts, lanes, spacing)
-    if certify:
-        _check_required_clearance(result)
-    return result
+    return Plan(workspace, configurations, segment_times(n, schedule.fractions), positions,
+                schedule.legs * (n - 1), counts, lanes, spacing)
+
+
+def _disc_plan(workspace, configurations, counts):
+    """Return the 'discs' variant's Plan (core.discs), its legs timed by their length."""
+    n, k, _ = configurations.shape
+    layout = workspace.disc_layout
+    disc = discs.section(configurations, layout)
+    times = length_times(disc.positions, disc.waypoint_indices)
+    lanes = layout.top + discs.lane_offsets(k, layout)
+    return Plan(workspace, configurations, times, disc.positions, disc.leg_names, counts,
+                lanes, None, disc.waypoint_indices)
 
 
 def _check_required_clearance(result):
     """
     Raise CLEARANCE_BELOW_REQUIRED if the certified clearance is not enough.
 
-    Not enough means below workspace.required_clearance, or not above the
-    numerical resolution of the coordinates (then rounding could hide a touch).
+    Not enough means below workspace.required_clearance (the surface gap when
+    robots or obstacles have a radius, else the centre distance), or a centre
+    distance not above the numerical resolution of the coordinates (then
+    rounding could hide a touch).
     """
     required = result.workspace.required_clearance
-    clearance = result.clearance
-    resolution = clearance.resolution
-    if clearance.distance >= required and clearance.distance > resolution:
+    resolution = result.clearance.resolution
+    trusted = result.clearance.distance > resolution
+    certificate = result.gap if trusted else result.clearance
+    if certificate.distance >= required and trusted:
         return
-    if clearance.distance > resolution:
-        limit = f'< required {required:.6g}'
-    else:
+    if not trusted:
         limit = f'<= {resolution:.3g}, the numerical resolution of coordinates this large'
-    a, b = clearance.indices
-    what = (f'robots {a} and {b}' if clearance.kind == 'robots'
+    elif result.workspace.has_bodies:
+        limit = f'surface to surface (gap), < required {required:.6g}'
+    else:
+        limit = f'< required {required:.6g}'
+    a, b = certificate.indices
+    what = (f'robots {a} and {b}' if certificate.kind == 'robots'
             else f'robot {a} and obstacle {b}')
-    segment = clearance.leg // result.legs_per_segment
+    segment = result.segment_of(certificate.leg)
     raise PlanningError(
         ErrorCode.CLEARANCE_BELOW_REQUIRED,
-        f'{what} come within {clearance.distance:.6g} {limit} on leg '
-        f'{clearance.leg} ({result.leg_names[clearance.leg]} of segment C_{segment + 1} -> '
-        f'C_{segment + 2}) at tau {clearance.tau:.6g}',
-        configuration=segment, robots=[a] if clearance.kind == 'obstacle' else [a, b],
-        obstacle=b if clearance.kind == 'obstacle' else None, clearance=clearance)
+        f'{what} come within {certificate.distance:.6g} {limit} on leg '
+        f'{certificate.leg} ({result.leg_names[certificate.leg]} of segment C_{segment + 1} -> '
+        f'C_{segment + 2}) at tau {certificate.tau:.6g}',
+        configuration=segment, robots=[a] if certificate.kind == 'obstacle' else [a, b],
+        obstacle=b if certificate.kind == 'obstacle' else None, clearance=certificate)

@@ -39,7 +39,9 @@ SCHEDULES = {
     'paper': Schedule(PAPER_LEGS, PAPER_FRACTIONS),
     'spread': Schedule(SPREAD_LEGS, SPREAD_FRACTIONS),
 }
-VARIANTS = tuple(SCHEDULES)
+# 'discs' has no fixed schedule: its legs depend on the pillars each robot passes
+# (core.discs); its breakpoints come with the plan.
+VARIANTS = (*SCHEDULES, 'discs')
 
 
 def lane_heights(robot_count: int, obstacle_count: int, lane_spacing: float, lane_base: float,

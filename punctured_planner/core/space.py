@@ -10,10 +10,12 @@ the domains of continuity are well defined.
 """
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import numpy.typing as npt
 
+from .discs import DiscLayout
 from .errors import ErrorCode, PlanningError
 from .sections import VARIANTS
 from .validation import first_out_of_range, MAX_COORDINATE
@@ -104,7 +106,9 @@ def choose_frame(obstacles: np.ndarray) -> Frame:
 
 
 def _checked_frame(frame, dimension):
-    """Return frame=(origin, e1, e2) as a Frame after checking dimension and orthonormality."""
+    """Return a Frame or (origin, e1, e2) as a Frame after checking dimension and orthonormality."""
+    if isinstance(frame, Frame):
+        frame = (frame.origin, frame.e1, frame.e2)
     origin, e1, e2 = (np.asarray(v, dtype=float).reshape(-1) for v in frame)
     if not (origin.size == e1.size == e2.size == dimension):
         raise PlanningError(ErrorCode.INVALID_REQUEST,
@@ -120,21 +124,33 @@ class Workspace:
     """
     The obstacles Q_r in R^d, the frame, and the planner's options.
 
-    ``variant`` is 'paper' (the paper's construction, exact) or 'spread' (adds
-    the spreading leg S and lanes `lane_spacing` apart beyond the obstacles).
-    ``required_clearance`` refuses plans whose certified clearance is below it.
+    ``variant`` is 'paper' (the paper's construction, exact), 'spread' (adds
+    the spreading leg S and lanes `lane_spacing` apart beyond the obstacles) or
+    'discs' (robots and obstacles with radii; doc/design.md section 7).
+    ``robot_radius`` R and ``obstacle_radius`` rho (a scalar, or one per
+    obstacle) make robots and obstacles discs (balls for d >= 3); then a
+    configuration whose bodies overlap is refused.
+    ``required_clearance`` refuses plans whose certified clearance is below it:
+    the centre distance for point robots and obstacles, the surface gap
+    (Plan.min_gap) as soon as a radius is set.
+    ``frame`` is the core's own Frame or (origin, e1, e2); by default the
+    frame is chosen from the obstacles (choose_frame).
     """
 
     def __init__(self, obstacles: npt.ArrayLike, dimension: int | None = None,
                  frame: Frame | tuple | None = None, lane_spacing: float = 1.0,
                  variant: str = 'paper', min_spacing: float = 0.5,
-                 required_clearance: float = 0.0) -> None:
+                 required_clearance: float = 0.0, robot_radius: float = 0.0,
+                 obstacle_radius: npt.ArrayLike = 0.0) -> None:
         """Validate the obstacles and options and fix the frame."""
         obstacles = np.asarray(obstacles, dtype=float)
         if obstacles.size == 0:
-            if dimension is None:
+            if obstacles.ndim == 2 and obstacles.shape[1] > 0:
+                dimension = obstacles.shape[1] if dimension is None else dimension
+            elif dimension is None:
                 raise PlanningError(ErrorCode.INVALID_REQUEST,
-                                    'without obstacles the dimension must be given')
+                                    f'obstacles of shape {obstacles.shape} do not give the '
+                                    f'dimension d: pass dimension=d or a (0, d) array')
             obstacles = obstacles.reshape(0, dimension)
         if obstacles.ndim != 2 or (dimension is not None and obstacles.shape[1] != dimension):
             raise PlanningError(ErrorCode.INVALID_REQUEST,
@@ -158,6 +174,8 @@ class Workspace:
         self.lane_spacing = float(lane_spacing)
         self.min_spacing = float(min_spacing)
         self.required_clearance = float(required_clearance)
+        self.robot_radius, self.obstacle_radii = _checked_radii(robot_radius, obstacle_radius,
+                                                                len(obstacles))
         self._reject_coincident_obstacles()
         self.frame = (choose_frame(obstacles) if frame is None
                       else _checked_frame(frame, self.dimension))
@@ -202,3 +220,39 @@ class Workspace:
     def obstacle_count(self) -> int:
         """Return r, the number of obstacles."""
         return len(self.obstacles)
+
+    @property
+    def has_bodies(self) -> bool:
+        """Return whether robots or obstacles have a radius (then gaps, not distances, count)."""
+        return self.robot_radius > 0 or bool(np.any(self.obstacle_radii > 0))
+
+    @cached_property
+    def disc_layout(self) -> DiscLayout:
+        """Return the pillars, reaches and pitches of the 'discs' construction."""
+        return DiscLayout.from_radii(self.frame, self.obstacles, self.robot_radius,
+                                     self.obstacle_radii, self.lane_spacing, self.min_spacing)
+
+
+def _checked_radii(robot_radius, obstacle_radius, obstacle_count):
+    """Return (R, rho (r,)) after checking they are finite, non-negative and rho has r values."""
+    try:
+        radius = float(robot_radius)
+        radii = np.asarray(obstacle_radius, dtype=float)
+    except (TypeError, ValueError):
+        raise PlanningError(ErrorCode.INVALID_REQUEST,
+                            'robot_radius and obstacle_radius must be real numbers') from None
+    if not (np.isfinite(radius) and radius >= 0):
+        raise PlanningError(ErrorCode.INVALID_REQUEST,
+                            f'robot_radius must be finite and non-negative, got {radius}')
+    if radii.ndim == 0:
+        radii = np.full(obstacle_count, float(radii))
+    if radii.shape != (obstacle_count,):
+        raise PlanningError(ErrorCode.INVALID_REQUEST,
+                            f'obstacle_radius must be a scalar or one value per obstacle '
+                            f'(shape ({obstacle_count},)), got shape {radii.shape}')
+    bad = np.flatnonzero(~(np.isfinite(radii) & (radii >= 0)))
+    if bad.size:
+        raise PlanningError(ErrorCode.INVALID_REQUEST,
+                            f'obstacle {bad[0]}: obstacle_radius must be finite and '
+                            f'non-negative, got {radii[bad[0]]}', obstacle=int(bad[0]))
+    return radius, radii

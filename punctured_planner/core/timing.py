@@ -17,6 +17,25 @@ def leg_lengths(positions: np.ndarray) -> np.ndarray:
     return np.sqrt(np.einsum('vkd,vkd->vk', steps, steps)).max(axis=1)
 
 
+def length_times(positions: np.ndarray, waypoint_indices: np.ndarray) -> np.ndarray:
+    """
+    Return (V,) breakpoint parameters with waypoint m at tau_m = m / (n - 1).
+
+    Inside a segment each leg takes a share of [tau_m, tau_{m+1}] proportional
+    to its length (its fastest robot's displacement): continuous in the
+    positions, and a leg of length 0 takes no time.
+    """
+    n = len(waypoint_indices)
+    lengths = leg_lengths(positions)
+    times = np.empty(len(positions))
+    for m in range(n - 1):
+        first, last = waypoint_indices[m], waypoint_indices[m + 1]
+        cumulative = np.concatenate([[0.0], np.cumsum(lengths[first:last])])
+        times[first:last + 1] = (m + cumulative / cumulative[-1]) / (n - 1)
+    times[waypoint_indices] = np.arange(n) / (n - 1)
+    return times
+
+
 def breakpoint_stamps(positions: np.ndarray, max_speed: float) -> np.ndarray:
     """Return (V,) seconds from the start at which the robots reach each breakpoint."""
     if not max_speed > 0:

@@ -9,6 +9,7 @@ obstacle at fault.
 
 import numpy as np
 import numpy.typing as npt
+from scipy.spatial import cKDTree
 
 from .errors import ErrorCode, PlanningError
 from .pairs import pair_difference_matrix, point_pairs, with_obstacles
@@ -157,8 +158,47 @@ def _coincidences(configurations, obstacles):
     return _sorted_coincidence(configurations), on
 
 
-def validate_configurations(configurations: npt.ArrayLike, obstacles: np.ndarray) -> np.ndarray:
-    """Return the request as a float (n, k, d) array after every check, or raise PlanningError."""
+def _first_overlap(configurations, obstacles, robot_radius, obstacle_radii):
+    """
+    Return ((m, a, b, distance) overlapping robot discs, (m, robot, obstacle, distance)).
+
+    Either is None when there is none; the first configuration with one wins.
+    Touching bodies (distance equal to the sum of the radii) do not overlap.
+    """
+    robots = None
+    if robot_radius > 0:
+        for m, configuration in enumerate(configurations):
+            pairs = cKDTree(configuration).query_pairs(2 * robot_radius, output_type='ndarray')
+            if pairs.size:
+                gaps = np.linalg.norm(configuration[pairs[:, 0]] - configuration[pairs[:, 1]],
+                                      axis=1)
+                inside = np.flatnonzero(gaps < 2 * robot_radius)
+                if inside.size:
+                    a, b = sorted(int(i) for i in pairs[inside[0]])
+                    robots = (m, a, b, float(gaps[inside[0]]))
+                    break
+    on = None
+    if len(obstacles) and (robot_radius > 0 or np.any(obstacle_radii > 0)):
+        reach = robot_radius + obstacle_radii
+        for m, configuration in enumerate(configurations):
+            distance = np.linalg.norm(configuration[:, None] - obstacles[None], axis=2)
+            hits = np.argwhere(distance < reach[None])
+            if hits.size:
+                robot, obstacle = (int(v) for v in hits[0])
+                on = (m, robot, obstacle, float(distance[robot, obstacle]))
+                break
+    return robots, on
+
+
+def validate_configurations(configurations: npt.ArrayLike, obstacles: np.ndarray,
+                            robot_radius: float = 0.0,
+                            obstacle_radii: np.ndarray | None = None) -> np.ndarray:
+    """
+    Return the request as a float (n, k, d) array after every check, or raise PlanningError.
+
+    With radii, robot discs that overlap (ROBOTS_COINCIDE) and a robot disc that
+    overlaps an obstacle's (ROBOT_ON_OBSTACLE) are refused too.
+    """
     configurations, all_finite = _as_array(configurations, obstacles.shape[1])
     if not all_finite:
         m, robot, axis = (int(v) for v in np.argwhere(~np.isfinite(configurations))[0])
@@ -177,4 +217,22 @@ def validate_configurations(configurations: npt.ArrayLike, obstacles: np.ndarray
                             f'configuration {m}: robot {robot} is on obstacle {obstacle} '
                             f'at {obstacles[obstacle].tolist()}', configuration=m,
                             robots=[robot], obstacle=obstacle)
+    if obstacle_radii is None:
+        obstacle_radii = np.zeros(len(obstacles))
+    overlap, on_obstacle = _first_overlap(configurations, obstacles, robot_radius,
+                                          obstacle_radii)
+    if overlap is not None:
+        m, a, b, distance = overlap
+        raise PlanningError(ErrorCode.ROBOTS_COINCIDE,
+                            f'configuration {m}: the discs of robots {a} and {b} overlap: '
+                            f'centres {distance:.6g} apart, less than 2 robot_radius = '
+                            f'{2 * robot_radius:.6g}', configuration=m, robots=[a, b])
+    if on_obstacle is not None:
+        m, robot, obstacle, distance = on_obstacle
+        raise PlanningError(ErrorCode.ROBOT_ON_OBSTACLE,
+                            f'configuration {m}: robot {robot} overlaps obstacle {obstacle} '
+                            f'at {obstacles[obstacle].tolist()}: centres {distance:.6g} '
+                            f'apart, less than robot_radius + obstacle_radius = '
+                            f'{robot_radius + obstacle_radii[obstacle]:.6g}',
+                            configuration=m, robots=[robot], obstacle=obstacle)
     return configurations

@@ -57,7 +57,7 @@ def _leg_label(plan, tau):
     """Return 'C_m -> C_m+1: <leg name>' for the leg that contains tau."""
     legs = len(plan.leg_names)
     leg = int(np.clip(np.searchsorted(plan.times, tau, side='right') - 1, 0, legs - 1))
-    segment = leg // plan.legs_per_segment
+    segment = plan.segment_of(leg)
     return f'C_{segment + 1} -> C_{segment + 2}: {plan.leg_names[leg]}'
 
 

@@ -1,0 +1,257 @@
+"""
+Disc robots among pillars: the variant 'discs' (doc/design.md section 7).
+
+Robots are discs (balls for d >= 3) of radius R, obstacle j a pillar of radius
+rho_j; the surface gap of two robots is |x_a - x_b| - 2R, of a robot and a
+pillar |x - q_j| - R - rho_j. Write p(x) for the e1 projection, h(x) for the e2
+offset and w_j = R + rho_j + mu_j for the reach of pillar j, where the passing
+margin mu_j = clip(R - rho_j, 0, min_spacing / 2) keeps robots off the pillars
+they pass without w_j exceeding 2R when rho_j <= R (w_j = min_spacing / 2 when
+both radii are 0, so point robots still keep off point obstacles).
+
+The construction keeps the paper's skeleton, H(C_m), Gamma, H(C_{m+1})^-1
+(Remark 2.3), with a new deformation H onto a new kind of base configuration:
+
+* sidestep and rise: the whole fleet translates along e2 by
+  T(C) = max(0, top - min_i h(x_i)), top = max_j (h(q_j) + w_j + a_j), while
+  each robot in the shadow of pillar j (|p(x) - p(q_j)| < w_j) is pushed along
+  e1, away from p(q_j) on its own side (a robot whose projection equals p(q_j)
+  counts as right of it, as the paper's numbering puts robots after
+  obstacles), by lambda_j(u) (w_j - |p(x) - p(q_j)|). Here u = h(x) + s - h(q_j)
+  is the robot's height relative to the pillar after rising by s, and
+  lambda_j(u) = clip((w_j + a_j - |u|) / a_j, 0, 1) with a_j = w_j / 2: full
+  push while |u| <= w_j, linear ramps of height a_j on both sides. Pushes of
+  several pillars add up. Each robot's e1 offset is piecewise linear in s with
+  kinks only where u crosses +-w_j, +-(w_j + a_j), so the breakpoints of all
+  robots together describe the motion exactly. A push already due at s = 0 is
+  made first, along e1 only (the sidestep leg). At s = T every robot is above
+  every zone, so the fleet ends as C + T e2, a translate of C.
+* gather (CAPT's synchronised straight lines, Turpin, Michael & Kumar): every
+  robot moves on a straight line to slot rank(x) of the staging line at height
+  top (the axis itself when there are no pillars) centred on the mean
+  robot projection, slots g = max(min_spacing, 4R / sqrt 3) apart along e1;
+  rank orders robots by projection, ties by index.
+* Gamma between staging lines: robot i lifts to lane top + (i + 1) c with
+  c = max(lane_spacing, 2R), slides, drops (the paper's section, equation 3.1).
+
+Continuity and domains. On a stratum A_i the order of all k + r projections,
+ties included, is locally constant, so the side of every push and the ranks
+are; T, the pushes (continuous in p, h and zero at the shadow's edge), the
+slot centre and every breakpoint move continuously. The motion is therefore
+continuous on every A_{j_1} x ... x A_{j_n}, hence on every domain of the
+paper, whose projection counts, domains and TC_n it shares. Breakpoints that
+appear as a robot enters a shadow carry a push of size 0, so they do not
+change the motion.
+
+Theorem (bodies never touch). Let S = max(4R, 3R + max_j rho_j). Suppose in
+every configuration (a) robot centres are at least S apart, (b) no robot disc
+overlaps a pillar (|x - q_j| >= R + rho_j; validation refuses the rest), and
+(c) any two pillars j, l satisfy |p(q_j) - p(q_l)| >= w_j + w_l + 2R or
+|h(q_j) - h(q_l)| >= w_j + a_j + w_l + a_l + 2R. Then min_gap >= 0.
+
+Proof. Every leg is one of the following.
+(1) Sidestep and rise, robot-pillar. While |u| > w_j the e2 distance to q_j
+exceeds w_j. While |u| <= w_j the push of q_j is full, so the robot's e1
+offset from p(q_j) is at least w_j before any other push; by (c) no pillar on
+the other side pushes it back then (that pillar would be within w_j + w_l of
+p(q_j) in e1 and within w_j + a_j + w_l + a_l in e2, which (c) excludes), and
+pushes from pillars on the same side only add. A robot outside every shadow
+never moves in e1 while it passes a pillar. So the distance stays >= w_j.
+(2) Sidestep and rise, robot-robot. The e2 and other coordinates of all
+robots change by the same s, so two robots whose distance in those
+coordinates is at least 2R never touch. Otherwise their e1 distance is at
+least sqrt(S^2 - 4R^2) > w_max, so they cannot be in one shadow on one side,
+and by (c) they are not pushed towards each other by two pillars at once; so
+at most one of them moves towards the other, by at most w_max <= S - 2R, and
+(|dp| - w_max)^2 + dh^2 >= (S - w_max)^2 >= 4R^2 because |dp|^2 + dh^2 >= S^2.
+(3) Gather. It starts from C + T e2 (pairwise >= S) and ends on slots >= g
+apart along e1 in projection order. For robots a, b with rank a < rank b the
+start difference P = x_b - x_a has P.e1 >= 0 and the end difference Q is a
+positive multiple of e1, so P.Q >= 0 and |(1 - t) P + t Q|^2 >=
+(1 - t)^2 S^2 + t^2 g^2 >= S^2 g^2 / (S^2 + g^2) >= 4R^2 for g >= 2RS /
+sqrt(S^2 - 4R^2), which g = 4R / sqrt 3 satisfies for S >= 4R. The start, the
+slots and so the straight lines lie in the half-space h >= top, where every
+robot is at least w_j from every pillar.
+(4) Gamma. Lifts and drops are along e2 in columns g >= 2R apart, slides along
+e1 in lanes c >= 2R apart, all in h >= top.
+The inverse legs are the same legs run backwards. QED.
+
+Outside the condition the plan is made all the same; the exact certificate
+(Plan.min_gap) says what it achieved and required_clearance refuses it.
+"""
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:  # space imports this module: the Frame type only, for annotations
+    from .space import Frame
+
+# The push zone of pillar j in relative height u: full push for |u| <= FULL w_j,
+# none beyond ZONE w_j, linear between. The push to w_j lambda_j(u) then traces
+# the octagon's half circumscribing the circle of radius w_j: the tangents at
+# 0 and 45 degrees meet at u = (sqrt 2 - 1) w_j, the 45 degree one reaches the
+# axis at u = sqrt 2 w_j.
+FULL, ZONE = np.sqrt(2.0) - 1.0, np.sqrt(2.0)
+# Slot spacing for robots S = 4R apart: 4R / sqrt(3) keeps the gather at 2R.
+_SLOT_FACTOR = 4.0 / np.sqrt(3.0)
+
+SIDESTEP, RISE, GATHER = 'sidestep', 'rise', 'gather'
+LIFT, SLIDE, DROP = 'lift', 'slide', 'drop'
+
+
+@dataclass(frozen=True, eq=False)
+class DiscLayout:
+    """
+    What the construction fixes per workspace: the pillars in frame coordinates and pitches.
+
+    reach w_j and ramp a_j per pillar, the staging height top (0, the axis,
+    without pillars), the slot spacing g and the lane pitch c (module docstring).
+    """
+
+    frame: 'Frame'
+    pillar_projections: np.ndarray
+    pillar_offsets: np.ndarray
+    reach: np.ndarray
+    full: np.ndarray
+    zone: np.ndarray
+    top: float
+    slot_spacing: float
+    lane_pitch: float
+
+    @classmethod
+    def from_radii(cls, frame: 'Frame', obstacles: np.ndarray, robot_radius: float,
+                   obstacle_radius: np.ndarray, lane_spacing: float,
+                   min_spacing: float) -> 'DiscLayout':
+        """Return the layout for pillars (r, d) of radii (r,) and robots of radius R."""
+        # A margin mu_j = clip(R - rho_j, 0, min_spacing / 2) keeps robots off pillars
+        # they pass without making w_j exceed 2R, so S stays 4R for rho_j <= R.
+        margin = np.clip(robot_radius - obstacle_radius, 0.0, 0.5 * min_spacing)
+        reach = robot_radius + obstacle_radius + margin
+        reach = np.where(reach > 0, reach, 0.5 * min_spacing)
+        offsets = frame.offset(obstacles)
+        top = float((offsets + ZONE * reach).max()) if len(obstacles) else 0.0
+        return cls(frame, frame.project(obstacles), offsets, reach, FULL * reach, ZONE * reach,
+                   top,
+                   max(min_spacing, _SLOT_FACTOR * robot_radius),
+                   max(lane_spacing, 2.0 * robot_radius))
+
+    def separation(self, robot_radius: float) -> float:
+        """Return S = max(4R, 3R + max rho): the robot spacing the theorem assumes."""
+        widest = float(self.reach.max(initial=robot_radius)) - robot_radius
+        return max(4.0 * robot_radius, 3.0 * robot_radius + widest)
+
+
+@dataclass(frozen=True)
+class Rise:
+    """The sidestep and rise of one configuration: e2 shifts (B,) and e1 offsets (B, k)."""
+
+    lift: np.ndarray
+    shift: np.ndarray
+
+    def positions(self, configuration: np.ndarray, frame: 'Frame') -> np.ndarray:
+        """Return the (B + 1, k, d) breakpoints: C, then the robots after each push/rise."""
+        moved = (configuration[None] + self.shift[..., None] * frame.e1
+                 + self.lift[:, None, None] * frame.e2)
+        return np.concatenate([configuration[None], moved])
+
+
+def push_factor(relative_height: np.ndarray, full: np.ndarray, zone: np.ndarray) -> np.ndarray:
+    """Return lambda_j(u) = clip((zone - |u|) / (zone - full), 0, 1): 1 near, 0 beyond zone."""
+    return np.clip((zone - np.abs(relative_height)) / (zone - full), 0.0, 1.0)
+
+
+def rise(configuration: np.ndarray, layout: DiscLayout) -> Rise:
+    """
+    Return the sidestep and rise of configuration (k, d) (module docstring).
+
+    The breakpoints are s = 0 (after the sidestep), T, and every s in (0, T)
+    where a robot in a pillar's shadow crosses an edge of its zone.
+    """
+    frame = layout.frame
+    p, h = frame.project(configuration), frame.offset(configuration)
+    if layout.reach.size == 0:
+        return Rise(np.zeros(1), np.zeros((1, len(p))))
+    total = max(0.0, layout.top - float(h.min()))
+    signed = p[:, None] - layout.pillar_projections[None, :]
+    robots, pillars = np.nonzero(np.abs(signed) < layout.reach[None, :])
+    if robots.size == 0:
+        return Rise(np.array([0.0, total]), np.zeros((2, len(p))))
+    reach, full, zone = layout.reach[pillars], layout.full[pillars], layout.zone[pillars]
+    # Zone edges in s: u = h + s - h_q crosses -zone, -full, full, zone.
+    edges = (layout.pillar_offsets[pillars] - h[robots])[:, None] + np.stack(
+        [-zone, -full, full, zone], axis=1)
+    lift = np.unique(np.concatenate([[0.0, total], np.clip(edges.ravel(), 0.0, total)]))
+    relative = h[robots][:, None] + lift[None, :] - layout.pillar_offsets[pillars][:, None]
+    depth = reach - np.abs(signed[robots, pillars])
+    direction = np.where(signed[robots, pillars] >= 0, 1.0, -1.0)
+    push = push_factor(relative, full[:, None], zone[:, None]) * (direction * depth)[:, None]
+    shift = np.zeros((lift.size, len(p)))
+    np.add.at(shift.T, robots, push)
+    return Rise(lift, shift)
+
+
+def staging_slots(configuration: np.ndarray, layout: DiscLayout) -> np.ndarray:
+    """
+    Return the (k, d) slots of the staging line for configuration (k, d).
+
+    Slot rank(x) lies (rank - (k - 1) / 2) g along e1 from the mean robot
+    projection, on the line at height top.
+    """
+    frame = layout.frame
+    p = frame.project(configuration)
+    k = len(p)
+    rank = np.empty(k)
+    rank[np.lexsort((np.arange(k), p))] = np.arange(k)
+    along = p.mean() + (rank - (k - 1) / 2) * layout.slot_spacing
+    return frame.axis_points(along) + layout.top * frame.e2
+
+
+def lane_offsets(robot_count: int, layout: DiscLayout) -> np.ndarray:
+    """Return the (k,) e2 lifts from the staging line to robot i's lane: (i + 1) c."""
+    return (1.0 + np.arange(robot_count)) * layout.lane_pitch
+
+
+@dataclass(frozen=True)
+class DiscSection:
+    """The breakpoints of the whole motion, their leg names and the waypoints' indices."""
+
+    positions: np.ndarray
+    leg_names: tuple[str, ...]
+    waypoint_indices: np.ndarray
+
+
+def section(configurations: np.ndarray, layout: DiscLayout) -> DiscSection:
+    """
+    Return the disc section through configurations (n, k, d): H(C_m), Gamma, H(C_{m+1})^-1.
+
+    Legs along which no robot moves are left out; the configurations stay
+    breakpoints, exactly.
+    """
+    n, k, _ = configurations.shape
+    e2 = layout.frame.e2
+    lanes = lane_offsets(k, layout)
+    deformations = []
+    for configuration in configurations:
+        risen = rise(configuration, layout).positions(configuration, layout.frame)
+        names = [SIDESTEP] + [RISE] * (len(risen) - 2)
+        deformations.append((risen, names, staging_slots(configuration, layout)))
+    stages, names, waypoints = [configurations[0]], [], [0]
+    for m in range(n - 1):
+        risen, rise_names, slots = deformations[m]
+        back, back_names, next_slots = deformations[m + 1]
+        segment = ([(stage, name) for stage, name in zip(risen[1:], rise_names)]
+                   + [(slots, GATHER), (slots + lanes[:, None] * e2, LIFT),
+                      (next_slots + lanes[:, None] * e2, SLIDE), (next_slots, DROP),
+                      (back[-1], GATHER + '^-1')]
+                   + [(stage, name + '^-1')
+                      for stage, name in zip(back[-2::-1], back_names[::-1])])
+        for stage, name in segment:
+            if np.array_equal(stage, stages[-1]):
+                continue
+            stages.append(stage)
+            names.append(name)
+        stages[-1] = configurations[m + 1]
+        waypoints.append(len(stages) - 1)
+    return DiscSection(np.stack(stages), tuple(names), np.array(waypoints))
