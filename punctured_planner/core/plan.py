@@ -15,8 +15,8 @@ import numpy as np
 import numpy.typing as npt
 from scipy.spatial import cKDTree
 
-from .certificate import certify, Clearance
 from . import discs
+from .certificate import certify, Clearance
 from .complexity import domain_range, sequential_complexity
 from .deformations import desingularize, desingularizing_shift, spread
 from .errors import ErrorCode, PlanningError

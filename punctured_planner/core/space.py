@@ -106,7 +106,7 @@ def choose_frame(obstacles: np.ndarray) -> Frame:
 
 
 def _checked_frame(frame, dimension):
-    """Return a Frame or (origin, e1, e2) as a Frame after checking dimension and orthonormality."""
+    """Return a Frame or (origin, e1, e2) as a Frame, dimension and orthonormality checked."""
     if isinstance(frame, Frame):
         frame = (frame.origin, frame.e1, frame.e2)
     origin, e1, e2 = (np.asarray(v, dtype=float).reshape(-1) for v in frame)
