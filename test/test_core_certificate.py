@@ -10,7 +10,7 @@ def test_segment_minimum_closed_form():
     """Crossing, receding, approaching-but-stopping and motionless relative motions."""
     start = np.array([[-1.0, 0.5], [1.0, 0.0], [3.0, 0.0], [0.0, 2.0]])
     velocity = np.array([[2.0, 0.0], [1.0, 0.0], [-1.0, 0.0], [0.0, 0.0]])
-    squared, t = segment_minimum(start, velocity)
+    squared, t = segment_minimum(start.T, velocity.T)
     assert np.allclose(np.sqrt(squared), [0.5, 1.0, 2.0, 2.0])
     assert np.allclose(t, [0.5, 0.0, 1.0, 0.0])
 

@@ -53,32 +53,43 @@ class Clearance:
     resolution: float = 0.0
 
 
+def _dot(a, b):
+    """Return the coordinate-wise dot product of coordinate-first arrays (d, ...)."""
+    total = a[0] * b[0]
+    for axis in range(1, a.shape[0]):
+        total += a[axis] * b[axis]
+    return total
+
+
 def segment_minimum(start: np.ndarray, velocity: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """
     Return (min squared distance, t*) of |start + t velocity| over t in [0, 1], elementwise.
 
-    start and velocity have shape (..., d); the result has shape (...). The
-    distance is taken from the closest point itself, not from |r0|^2 - <r0, v>^2
-    / |v|^2, which cancels catastrophically when robots nearly touch.
+    start and velocity are coordinate first, shape (d, ...) (one contiguous
+    plane per coordinate: much faster than a trailing axis of 2 or 3); the
+    result has shape (...). The distance is taken from the closest point
+    itself, not from |r0|^2 - <r0, v>^2 / |v|^2, which cancels catastrophically
+    when robots nearly touch.
     """
-    speed2 = np.einsum('...i,...i->...', velocity, velocity)
-    t = np.einsum('...i,...i->...', start, velocity)
+    speed2 = _dot(velocity, velocity)
+    t = _dot(start, velocity)
     np.divide(t, speed2, out=t, where=speed2 > 0)
     np.negative(t, out=t)
     np.maximum(t, 0.0, out=t)
     np.minimum(t, 1.0, out=t)
-    closest = t[..., None] * velocity
+    closest = t * velocity
     closest += start
-    return np.einsum('...i,...i->...', closest, closest), t
+    return _dot(closest, closest), t
 
 
 def _argmin_over_legs(start, end, legs, offsets=None):
     """
     Return (value, leg, pair, fraction) of the smallest segment minimum.
 
-    value is the distance, or with offsets (pairs,) the distance minus the
-    pair's offset (a surface gap): then each pair's own minimum over the legs
-    counts, and the smallest gap may belong to a pair that is not the closest.
+    start and end are (d, legs, pairs). value is the distance, or with offsets
+    (pairs,) the distance minus the pair's offset (a surface gap): then each
+    pair's own minimum over the legs counts, and the smallest gap may belong to
+    a pair that is not the closest.
     """
     squared, fractions = segment_minimum(start, end - start)
     if offsets is None:
@@ -93,14 +104,20 @@ def _argmin_over_legs(start, end, legs, offsets=None):
     return float(values[pair]), int(legs[leg]), pair, float(fractions[leg, pair])
 
 
+def _coordinate_first(points):
+    """Return (V, N, d) points as a contiguous (d, V, N) array."""
+    return np.ascontiguousarray(np.moveaxis(points, 2, 0))
+
+
 def _pairs_minimum(points, legs, a, b, offsets=None):
     """Return (value, leg, pair, fraction) of the closest pair (a[i], b[i]) over legs."""
     best = (np.inf, 0, 0, 0.0)
+    planes = _coordinate_first(points)
     step = max(1, _CHUNK_ELEMENTS // max(1, a.size * points.shape[2]))
     for first in range(0, legs.size, step):
         chunk = legs[first:first + step]
-        start = points[chunk][:, a] - points[chunk][:, b]
-        end = points[chunk + 1][:, a] - points[chunk + 1][:, b]
+        start = planes[:, chunk][:, :, a] - planes[:, chunk][:, :, b]
+        end = planes[:, chunk + 1][:, :, a] - planes[:, chunk + 1][:, :, b]
         best = min(best, _argmin_over_legs(start, end, chunk, offsets),
                    key=lambda item: item[0])
     return best
@@ -108,9 +125,11 @@ def _pairs_minimum(points, legs, a, b, offsets=None):
 
 def _direct_minimum(points, robot_count, obstacle_count, offsets=None):
     """Return (value, leg, pair, fraction) over every pair and every leg at once."""
-    relative = pair_difference_matrix(robot_count, obstacle_count) @ points
-    return _argmin_over_legs(relative[:-1], relative[1:], np.arange(points.shape[0] - 1),
-                             offsets)
+    a, b = point_pairs(robot_count, obstacle_count)
+    planes = _coordinate_first(points)
+    relative = planes[:, :, a] - planes[:, :, b]
+    return _argmin_over_legs(relative[:, :-1], relative[:, 1:],
+                             np.arange(points.shape[0] - 1), offsets)
 
 
 def _breakpoint_bound(positions, obstacles):

@@ -5,7 +5,7 @@ Robots are discs (balls for d >= 3) of radius R, obstacle j a pillar of radius
 rho_j; the surface gap of two robots is |x_a - x_b| - 2R, of a robot and a
 pillar |x - q_j| - R - rho_j. Write p(x) for the e1 projection, h(x) for the e2
 offset and w_j = R + rho_j + mu_j for the reach of pillar j, where the passing
-margin mu_j = clip(R - rho_j, 0, min_spacing / 2) keeps robots off the pillars
+margin mu_j = clip(R - rho_j, 0, R / 10) keeps robots off the pillars
 they pass without w_j exceeding 2R when rho_j <= R (w_j = min_spacing / 2 when
 both radii are 0, so point robots still keep off point obstacles).
 
@@ -13,24 +13,25 @@ The construction keeps the paper's skeleton, H(C_m), Gamma, H(C_{m+1})^-1
 (Remark 2.3), with a new deformation H onto a new kind of base configuration:
 
 * sidestep and rise: the whole fleet translates along e2 by
-  T(C) = max(0, top - min_i h(x_i)), top = max_j (h(q_j) + w_j + a_j), while
-  each robot in the shadow of pillar j (|p(x) - p(q_j)| < w_j) is pushed along
-  e1, away from p(q_j) on its own side (a robot whose projection equals p(q_j)
+  T(C) = max(0, top - min_i h(x_i)), top = max_j (h(q_j) + z_j), while each
+  robot in the shadow of pillar j (|p(x) - p(q_j)| < w_j) is pushed along e1,
+  away from p(q_j) on its own side (a robot whose projection equals p(q_j)
   counts as right of it, as the paper's numbering puts robots after
   obstacles), by lambda_j(u) (w_j - |p(x) - p(q_j)|). Here u = h(x) + s - h(q_j)
   is the robot's height relative to the pillar after rising by s, and
-  lambda_j(u) = clip((w_j + a_j - |u|) / a_j, 0, 1) with a_j = w_j / 2: full
-  push while |u| <= w_j, linear ramps of height a_j on both sides. Pushes of
-  several pillars add up. Each robot's e1 offset is piecewise linear in s with
-  kinks only where u crosses +-w_j, +-(w_j + a_j), so the breakpoints of all
-  robots together describe the motion exactly. A push already due at s = 0 is
-  made first, along e1 only (the sidestep leg). At s = T every robot is above
-  every zone, so the fleet ends as C + T e2, a translate of C.
+  lambda_j(u) = clip((z_j - |u|) / (z_j - f_j), 0, 1) with f_j = (sqrt 2 - 1) w_j
+  and z_j = sqrt 2 w_j: w_j lambda_j(u) is the half octagon circumscribing the
+  circle of radius w_j, so w_j lambda_j(u) >= sqrt(w_j^2 - u^2) for |u| <= w_j.
+  Pushes of several pillars add up. Each robot's e1 offset is then piecewise
+  linear in s with kinks only where u crosses +-f_j and +-z_j, so the
+  breakpoints of all robots together describe the motion exactly. A push
+  already due at s = 0 is made first, along e1 only (the sidestep leg). At
+  s = T every robot is above every zone, so the fleet ends as C + T e2.
 * gather (CAPT's synchronised straight lines, Turpin, Michael & Kumar): every
   robot moves on a straight line to slot rank(x) of the staging line at height
-  top (the axis itself when there are no pillars) centred on the mean
-  robot projection, slots g = max(min_spacing, 4R / sqrt 3) apart along e1;
-  rank orders robots by projection, ties by index.
+  top (the axis itself when there are no pillars) centred on the mean robot
+  projection, slots g = max(min_spacing, 4R / sqrt 3) apart along e1; rank
+  orders robots by projection, ties by index.
 * Gamma between staging lines: robot i lifts to lane top + (i + 1) c with
   c = max(lane_spacing, 2R), slides, drops (the paper's section, equation 3.1).
 
@@ -40,38 +41,44 @@ are; T, the pushes (continuous in p, h and zero at the shadow's edge), the
 slot centre and every breakpoint move continuously. The motion is therefore
 continuous on every A_{j_1} x ... x A_{j_n}, hence on every domain of the
 paper, whose projection counts, domains and TC_n it shares. Breakpoints that
-appear as a robot enters a shadow carry a push of size 0, so they do not
-change the motion.
+appear as a robot enters a shadow carry a push of size 0 and split legs along
+which every robot moves linearly, so they do not change the motion.
 
-Theorem (bodies never touch). Let S = max(4R, 3R + max_j rho_j). Suppose in
-every configuration (a) robot centres are at least S apart, (b) no robot disc
-overlaps a pillar (|x - q_j| >= R + rho_j; validation refuses the rest), and
-(c) any two pillars j, l satisfy |p(q_j) - p(q_l)| >= w_j + w_l + 2R or
-|h(q_j) - h(q_l)| >= w_j + a_j + w_l + a_l + 2R. Then min_gap >= 0.
+Theorem (bodies never touch). Let S = max(4R, 2R + max_j w_j), which is 4R
+when every rho_j <= R. Suppose in every configuration (a) robot centres are at
+least S apart, (b) no robot disc overlaps a pillar (|x - q_j| >= R + rho_j;
+validation refuses the rest), and (c) any two pillars j, l satisfy
+|p(q_j) - p(q_l)| >= w_j + w_l + 2R or |h(q_j) - h(q_l)| >= z_j + z_l + 2R.
+Then min_gap >= 0 (up to the rounding of the coordinates).
 
 Proof. Every leg is one of the following.
-(1) Sidestep and rise, robot-pillar. While |u| > w_j the e2 distance to q_j
-exceeds w_j. While |u| <= w_j the push of q_j is full, so the robot's e1
-offset from p(q_j) is at least w_j before any other push; by (c) no pillar on
-the other side pushes it back then (that pillar would be within w_j + w_l of
-p(q_j) in e1 and within w_j + a_j + w_l + a_l in e2, which (c) excludes), and
-pushes from pillars on the same side only add. A robot outside every shadow
-never moves in e1 while it passes a pillar. So the distance stays >= w_j.
-(2) Sidestep and rise, robot-robot. The e2 and other coordinates of all
-robots change by the same s, so two robots whose distance in those
-coordinates is at least 2R never touch. Otherwise their e1 distance is at
-least sqrt(S^2 - 4R^2) > w_max, so they cannot be in one shadow on one side,
-and by (c) they are not pushed towards each other by two pillars at once; so
-at most one of them moves towards the other, by at most w_max <= S - 2R, and
-(|dp| - w_max)^2 + dh^2 >= (S - w_max)^2 >= 4R^2 because |dp|^2 + dh^2 >= S^2.
+(1) Sidestep and rise, robot and pillar j. While |u| > w_j the e2 distance
+exceeds w_j. While |u| <= w_j, the push of j alone puts the robot at e1
+offset delta + lambda_j (w_j - delta) >= lambda_j w_j >= sqrt(w_j^2 - u^2)
+from p(q_j), so at distance >= w_j. Pushes of pillars on the same side only
+add to it. A pillar l on the other side pushes only while the robot is in its
+shadow and |u_l| < z_l, which puts l within w_j + w_l of p(q_j) in e1 and
+within w_j + z_l of h(q_j) in e2, excluded by (c). A robot pushed towards a
+pillar l whose shadow it was not in reaches it only if |p(q_j) - p(q_l)| <
+w_j + w_l, and then by (c) it is more than z_l + 2R from h(q_l) in e2.
+(2) Sidestep and rise, two robots. Their e2 and other coordinates change by
+the same s, so if those differ by at least 2R the robots never touch.
+Otherwise their e1 distance is at least sqrt(S^2 - 4R^2) > max w_j, so they
+are not in one shadow on one side, and by (c) no robot is pushed by two
+pillars at once (their shadows and zones would overlap). If both are pushed
+towards each other, by j and l, their zones overlap within 2R in e2, so by (c)
+p(q_l) - p(q_j) >= w_j + w_l + 2R while they stay within w_j of p(q_j) and w_l
+of p(q_l): 2R apart in e1. Otherwise at most one moves towards the other, by
+at most w_max <= S - 2R in e1, and (|dp| - w_max)^2 + dh^2 >= 4R^2 whenever
+|dp|^2 + dh^2 >= S^2.
 (3) Gather. It starts from C + T e2 (pairwise >= S) and ends on slots >= g
 apart along e1 in projection order. For robots a, b with rank a < rank b the
 start difference P = x_b - x_a has P.e1 >= 0 and the end difference Q is a
 positive multiple of e1, so P.Q >= 0 and |(1 - t) P + t Q|^2 >=
-(1 - t)^2 S^2 + t^2 g^2 >= S^2 g^2 / (S^2 + g^2) >= 4R^2 for g >= 2RS /
-sqrt(S^2 - 4R^2), which g = 4R / sqrt 3 satisfies for S >= 4R. The start, the
-slots and so the straight lines lie in the half-space h >= top, where every
-robot is at least w_j from every pillar.
+(1 - t)^2 S^2 + t^2 g^2 >= S^2 g^2 / (S^2 + g^2) >= 4R^2 for
+g >= 2RS / sqrt(S^2 - 4R^2), which g >= 4R / sqrt 3 satisfies for S >= 4R.
+The start, the slots and so the straight lines lie in the half-space h >= top,
+where every robot is at least z_j >= w_j from every pillar.
 (4) Gamma. Lifts and drops are along e2 in columns g >= 2R apart, slides along
 e1 in lanes c >= 2R apart, all in h >= top.
 The inverse legs are the same legs run backwards. QED.
@@ -94,6 +101,8 @@ if TYPE_CHECKING:  # space imports this module: the Frame type only, for annotat
 # 0 and 45 degrees meet at u = (sqrt 2 - 1) w_j, the 45 degree one reaches the
 # axis at u = sqrt 2 w_j.
 FULL, ZONE = np.sqrt(2.0) - 1.0, np.sqrt(2.0)
+# Passing margin mu_j, at most this fraction of R (see DiscLayout.from_radii).
+PASSING_MARGIN = 0.1
 # Slot spacing for robots S = 4R apart: 4R / sqrt(3) keeps the gather at 2R.
 _SLOT_FACTOR = 4.0 / np.sqrt(3.0)
 
@@ -106,8 +115,9 @@ class DiscLayout:
     """
     What the construction fixes per workspace: the pillars in frame coordinates and pitches.
 
-    reach w_j and ramp a_j per pillar, the staging height top (0, the axis,
-    without pillars), the slot spacing g and the lane pitch c (module docstring).
+    reach w_j, full-push and zone half-heights f_j, z_j per pillar, the staging
+    height top (0, the axis, without pillars), the slot spacing g and the lane
+    pitch c (module docstring).
     """
 
     frame: 'Frame'
@@ -125,9 +135,10 @@ class DiscLayout:
                    obstacle_radius: np.ndarray, lane_spacing: float,
                    min_spacing: float) -> 'DiscLayout':
         """Return the layout for pillars (r, d) of radii (r,) and robots of radius R."""
-        # A margin mu_j = clip(R - rho_j, 0, min_spacing / 2) keeps robots off pillars
-        # they pass without making w_j exceed 2R, so S stays 4R for rho_j <= R.
-        margin = np.clip(robot_radius - obstacle_radius, 0.0, 0.5 * min_spacing)
+        # A margin mu_j = clip(R - rho_j, 0, R / 10) keeps robots off the pillars they
+        # pass without making w_j exceed 2R, so S stays 4R for rho_j <= R; a wider one
+        # makes neighbouring pillars' zones overlap more often (measured in bench/).
+        margin = np.clip(robot_radius - obstacle_radius, 0.0, PASSING_MARGIN * robot_radius)
         reach = robot_radius + obstacle_radius + margin
         reach = np.where(reach > 0, reach, 0.5 * min_spacing)
         offsets = frame.offset(obstacles)
@@ -138,9 +149,23 @@ class DiscLayout:
                    max(lane_spacing, 2.0 * robot_radius))
 
     def separation(self, robot_radius: float) -> float:
-        """Return S = max(4R, 3R + max rho): the robot spacing the theorem assumes."""
-        widest = float(self.reach.max(initial=robot_radius)) - robot_radius
-        return max(4.0 * robot_radius, 3.0 * robot_radius + widest)
+        """Return S = max(4R, 2R + max w_j): the robot spacing the theorem assumes."""
+        return max(4.0 * robot_radius, 2.0 * robot_radius + float(self.reach.max(initial=0.0)))
+
+    def conflicting_pillars(self, robot_radius: float) -> np.ndarray:
+        """
+        Return the (c, 2) index pairs j < l of pillars that break condition (c).
+
+        Condition (c): |p(q_j) - p(q_l)| >= w_j + w_l + 2R or
+        |h(q_j) - h(q_l)| >= z_j + z_l + 2R, z the zone half-heights.
+        """
+        j, l = np.triu_indices(self.reach.size, 1)
+        wide = (np.abs(self.pillar_projections[j] - self.pillar_projections[l])
+                >= self.reach[j] + self.reach[l] + 2 * robot_radius)
+        tall = (np.abs(self.pillar_offsets[j] - self.pillar_offsets[l])
+                >= self.zone[j] + self.zone[l] + 2 * robot_radius)
+        bad = ~(wide | tall)
+        return np.stack([j[bad], l[bad]], axis=1)
 
 
 @dataclass(frozen=True)
