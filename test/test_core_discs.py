@@ -1,0 +1,187 @@
+"""
+The 'discs' variant: bodies never touch under the stated condition, and the paper's domains.
+
+The condition (punctured_planner/core/discs.py, doc/design.md section 7):
+robot centres at least S = max(4R, 2R + max w_j) apart, no disc overlapping a
+pillar, and pillar pairs meeting condition (c). The strategies build inputs
+that meet exactly that, adversarially: robots on a lattice of pitch exactly
+S (many pairs exactly S apart, many sharing projections with each other and
+with pillars), pillars on lattice cells, columns of robots between pillars,
+mirror-image goals.
+"""
+
+from hypothesis import assume, given, HealthCheck, settings, strategies as st
+import numpy as np
+import pytest
+
+from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
+from core_strategies import requests
+
+PROPERTY = settings(max_examples=120, deadline=None,
+                    suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+
+
+def no_contact(p):
+    """Return whether the certified gap is >= 0 up to the rounding of the coordinates."""
+    return p.min_gap >= -p.clearance.resolution
+
+
+@st.composite
+def lattice_requests(draw):
+    """Return (workspace, configurations (n, k, 2)) meeting the theorem's condition exactly."""
+    radius = draw(st.sampled_from([0.1, 0.25, 0.3]))
+    pitch = 4 * radius
+    columns, rows = draw(st.integers(2, 7)), draw(st.integers(2, 6))
+    cells = [(c, r) for c in range(columns) for r in range(rows)]
+    pillar_cells = draw(st.lists(st.sampled_from(cells), max_size=4, unique=True))
+    rho = [draw(st.sampled_from([0.0, 0.5, 1.0])) * radius for _ in pillar_cells]
+    free = [cell for cell in cells if cell not in pillar_cells]
+    assume(free)
+    k = draw(st.integers(1, min(len(free), 10)))
+    n = draw(st.integers(2, 3))
+    origin = np.array([draw(st.sampled_from([0.0, 0.37, -1.5])), 0.25])
+    chosen = [draw(st.permutations(free))[:k] for _ in range(n)]
+    mirror = [(columns - 1 - c, r) for c, r in chosen[0]]
+    if draw(st.booleans()) and not set(mirror) & set(pillar_cells):
+        chosen[-1] = mirror  # mirror-image goal: C_1 reflected through the lattice's middle
+    configurations = [origin + pitch * np.array(cells_, dtype=float) for cells_ in chosen]
+    pillars = origin + pitch * np.array(pillar_cells, dtype=float).reshape(-1, 2)
+    try:
+        workspace = Workspace(pillars, dimension=2, variant='discs', robot_radius=radius,
+                              obstacle_radius=np.array(rho))
+    except PlanningError as error:  # two pillars in one column share a projection
+        assume(error.code != ErrorCode.OBSTACLES_DEGENERATE)
+        raise
+    assume(len(workspace.disc_layout.conflicting_pillars(radius)) == 0)
+    return workspace, np.array(configurations)
+
+
+@PROPERTY
+@given(lattice_requests())
+def test_bodies_never_touch_when_the_condition_holds(case):
+    """The theorem: min_gap >= 0 on every input that meets the stated condition."""
+    workspace, configurations = case
+    p = plan(workspace, configurations, certify=False)
+    assert no_contact(p), (p.min_gap, p.gap, p.leg_names[p.gap.leg])
+
+
+@pytest.mark.parametrize('radius', [0.1, 0.25])
+@pytest.mark.parametrize('count', [2, 6, 12])
+def test_a_column_between_two_pillars_and_its_mirror(radius, count):
+    """Robots stacked 4R apart between two pillars at exactly the condition's distance."""
+    rho = radius
+    reach = 2 * radius  # w = R + rho + clip(R - rho, ...) = 2R for rho = R
+    gap = 2 * reach + 2 * radius
+    pillars = np.array([[0.0, 2.0], [gap, 2.0]])
+    workspace = Workspace(pillars, variant='discs', robot_radius=radius, obstacle_radius=rho)
+    assert len(workspace.disc_layout.conflicting_pillars(radius)) == 0
+    column = np.stack([np.full(count, gap / 2), 4 * radius * np.arange(count) - 3.0], axis=1)
+    # Robots whose discs overlap a pillar are not valid input: leave them out.
+    keep = np.min(np.linalg.norm(column[:, None] - pillars[None], axis=2), axis=1) >= 2 * radius
+    column = column[keep]
+    mirror = column[::-1]  # the column upside down: every robot swaps with its mirror image
+    # Every robot on the first pillar's projection, 4R apart, off the pillar.
+    heights = 4 * radius * np.arange(2 * count) - 3.0
+    heights = heights[np.abs(heights - 2.0) >= 2 * radius][:len(column)]
+    shared = np.stack([np.zeros(len(column)), heights], axis=1)
+    p = plan(workspace, [column, mirror, shared], certify=False)
+    assert no_contact(p), (p.min_gap, p.leg_names[p.gap.leg])
+
+
+@PROPERTY
+@given(requests(max_robots=6, max_obstacles=4, max_configurations=4))
+def test_domains_equal_the_paper_variant_and_waypoints_are_exact(request):
+    """Same projection counts, domain, index, count and TC_n; C_m is a breakpoint exactly."""
+    obstacles, configurations, _ = request
+    d = obstacles.shape[1]
+    paper = plan(Workspace(obstacles, dimension=d), configurations, certify=False)
+    discs = plan(Workspace(obstacles, dimension=d, variant='discs'), configurations,
+                 certify=False)
+    assert np.array_equal(discs.projection_counts, paper.projection_counts)
+    assert (discs.domain, discs.domain_index, discs.domain_count) == (
+        paper.domain, paper.domain_index, paper.domain_count)
+    assert discs.sequential_complexity == paper.sequential_complexity
+    assert np.array_equal(discs.positions[discs.waypoint_indices], configurations)
+    assert np.all(np.diff(discs.times) >= 0)
+    again = plan(Workspace(obstacles, dimension=d, variant='discs'), configurations,
+                 certify=False)
+    assert np.array_equal(again.positions, discs.positions)
+    assert np.array_equal(again.times, discs.times)
+
+
+@PROPERTY
+@given(requests(max_robots=5, max_obstacles=4, max_configurations=3, modes=('float',)),
+       st.sampled_from([0.0, 0.05]), st.integers(0, 2 ** 31))
+def test_a_small_change_inside_a_domain_moves_the_motion_little(request, radius, seed):
+    """Continuity, measured: a 1e-6 change that keeps every cp moves the motion by <= 1e-5."""
+    obstacles, configurations, _ = request
+    d = obstacles.shape[1]
+    workspace = Workspace(obstacles, dimension=d, variant='discs', robot_radius=radius,
+                          obstacle_radius=radius)
+    rng = np.random.default_rng(seed)
+    moved = configurations + rng.uniform(-1e-6, 1e-6, configurations.shape)
+    try:
+        before = plan(workspace, configurations, certify=False)
+        after = plan(workspace, moved, certify=False)
+    except PlanningError:
+        assume(False)
+    assume(np.array_equal(before.projection_counts, after.projection_counts))
+    assume(np.all(np.abs(configurations) < 1e3))
+    tau = np.linspace(0.0, 1.0, 2001)
+    change = np.abs(before.position(tau) - after.position(tau)).max()
+    assert change <= 1e-5, change
+
+
+def test_gap_is_distance_minus_radii_and_required_clearance_applies_to_it():
+    """min_gap is exact (centre distance - radii); required_clearance refuses on the gap."""
+    pillars = np.array([[0.0, 0.0]])
+    configurations = np.array([[[-2.0, -1.0], [2.0, -1.0]], [[2.0, 1.5], [-2.0, 1.5]]])
+    points = Workspace(pillars, variant='discs', min_spacing=0.5)
+    bodies = Workspace(pillars, variant='discs', min_spacing=0.5, robot_radius=0.2,
+                       obstacle_radius=0.1)
+    p = plan(bodies, configurations)
+    point_plan = plan(points, configurations)
+    assert p.min_clearance > 0
+    # The robot-robot part of the gap, found independently at dense samples.
+    tau = np.linspace(0, 1, 20001)
+    positions = p.position(tau)
+    robots = np.linalg.norm(positions[:, 0] - positions[:, 1], axis=1).min() - 0.4
+    obstacle = np.linalg.norm(positions - pillars[0], axis=2).min() - 0.3
+    assert p.min_gap <= min(robots, obstacle) + 1e-12
+    assert p.min_gap >= min(robots, obstacle) - 1e-3
+    assert point_plan.min_gap == point_plan.min_clearance
+    strict = Workspace(pillars, variant='discs', robot_radius=0.2, obstacle_radius=0.1,
+                       required_clearance=p.min_gap + 0.01)
+    with pytest.raises(PlanningError) as caught:
+        plan(strict, configurations)
+    assert caught.value.code == ErrorCode.CLEARANCE_BELOW_REQUIRED
+    assert '(gap)' in str(caught.value)
+
+
+@pytest.mark.parametrize('configuration, code, words', [
+    ([[0.0, -1.0], [0.3, -1.0]], ErrorCode.ROBOTS_COINCIDE, 'discs of robots 0 and 1 overlap'),
+    ([[0.0, -0.25], [3.0, -1.0]], ErrorCode.ROBOT_ON_OBSTACLE, 'robot 0 overlaps obstacle 0'),
+])
+def test_overlapping_bodies_are_refused_naming_the_culprits(configuration, code, words):
+    """A configuration whose discs overlap, or a disc on a pillar, is refused."""
+    workspace = Workspace([[0.0, 0.0]], variant='discs', robot_radius=0.2, obstacle_radius=0.1)
+    good = [[-2.0, -2.0], [2.0, -2.0]]
+    with pytest.raises(PlanningError) as caught:
+        plan(workspace, [good, configuration])
+    assert caught.value.code == code
+    assert words in str(caught.value)
+    assert caught.value.configuration == 1
+
+
+@pytest.mark.parametrize('options, words', [
+    ({'robot_radius': -0.1}, 'robot_radius must be finite and non-negative'),
+    ({'robot_radius': np.nan}, 'robot_radius must be finite and non-negative'),
+    ({'obstacle_radius': [0.1, -1.0]}, 'obstacle 1: obstacle_radius'),
+    ({'obstacle_radius': [0.1, 0.2, 0.3]}, 'one value per obstacle'),
+])
+def test_bad_radii_are_refused(options, words):
+    """A negative, non-finite or wrongly shaped radius is INVALID_REQUEST."""
+    with pytest.raises(PlanningError) as caught:
+        Workspace([[0.0, 0.0], [1.0, 0.0]], variant='discs', **options)
+    assert caught.value.code == ErrorCode.INVALID_REQUEST
+    assert words in str(caught.value)
