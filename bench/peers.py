@@ -214,9 +214,15 @@ def run_straight(query):
 
 
 class OmplPlanner:
-    """OMPL on the composite space of k robots in R^d among r obstacles, discs of RADIUS."""
+    """
+    OMPL on the composite space of k robots in R^d among r obstacles.
 
-    def __init__(self, query):
+    A state is valid when every robot pair is more than pair_gap apart and
+    robot and obstacle j more than obstacle_gaps[j] (by default discs of RADIUS:
+    SEPARATION each); the motion check runs every motion_step.
+    """
+
+    def __init__(self, query, pair_gap=SEPARATION, obstacle_gaps=None, motion_step=MOTION_STEP):
         """Build the state space, its bounds and the validity checker for the query."""
         from ompl import base as ob, util as ou
         ou.setLogLevel(ou.LOG_NONE)
@@ -233,8 +239,11 @@ class OmplPlanner:
         self.space.setBounds(bounds)
         # OMPL's resolution is a fraction of the space's extent.
         extent = (high - low) * np.sqrt(self.dimension)
-        self.resolution = float(MOTION_STEP / extent)
+        self.resolution = float(motion_step / extent)
         self.obstacles = query.obstacles
+        self.pair_gap2 = pair_gap ** 2
+        self.obstacle_gaps2 = (np.full(len(query.obstacles), SEPARATION) if obstacle_gaps is None
+                               else np.asarray(obstacle_gaps, float)) ** 2
         self.pairs = np.triu_indices(query.k, 1)
         self.checker = self._timed_valid
         self.calls, self.checker_seconds = 0, 0.0
@@ -250,17 +259,17 @@ class OmplPlanner:
         return valid
 
     def _valid(self, state):
-        """Return True if every robot pair and robot-obstacle pair is > SEPARATION apart."""
+        """Return True if every robot pair and robot-obstacle pair is farther than its gap."""
         x = np.fromiter((state[i] for i in range(self.dimension)), float,
                         self.dimension).reshape(self.k, self.d)
         a, b = self.pairs
         difference = x[a] - x[b]
-        if a.size and np.einsum('pi,pi->p', difference, difference).min() <= SEPARATION ** 2:
+        if a.size and np.einsum('pi,pi->p', difference, difference).min() <= self.pair_gap2:
             return False
         if len(self.obstacles):
             difference = x[:, None] - self.obstacles[None]
-            return bool(np.einsum('koi,koi->ko', difference,
-                                  difference).min() > SEPARATION ** 2)
+            return bool(np.all(np.einsum('koi,koi->ko', difference, difference)
+                               > self.obstacle_gaps2[None]))
         return True
 
     def _state(self, values):

@@ -10,12 +10,11 @@ with pillars), pillars on lattice cells, columns of robots between pillars,
 mirror-image goals.
 """
 
+from core_strategies import requests
 from hypothesis import assume, given, HealthCheck, settings, strategies as st
 import numpy as np
-import pytest
-
 from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
-from core_strategies import requests
+import pytest
 
 PROPERTY = settings(max_examples=120, deadline=None,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .pairs import pair_difference_matrix, point_pairs, with_obstacles
+from .pairs import point_pairs, with_obstacles
 
 # A clearance is trusted only above this fraction of the coordinate scale: the
 # breakpoints and the closed form each round to a few ulps of the largest

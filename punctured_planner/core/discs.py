@@ -32,8 +32,11 @@ The construction keeps the paper's skeleton, H(C_m), Gamma, H(C_{m+1})^-1
   top (the axis itself when there are no pillars) centred on the mean robot
   projection, slots g = max(min_spacing, 4R / sqrt 3) apart along e1; rank
   orders robots by projection, ties by index.
-* Gamma between staging lines: robot i lifts to lane top + (i + 1) c with
-  c = max(lane_spacing, 2R), slides, drops (the paper's section, equation 3.1).
+* Gamma between staging lines (the paper's section, equation 3.1, with shared
+  lanes): every robot lifts to its lane top + (l + 1) c, c = max(lane_spacing,
+  2R), slides to its next slot and drops. Robots whose slots keep their order
+  share a lane (shared_lanes), so a segment needs as many lanes as its longest
+  run of robots whose order reverses, not k.
 
 Continuity and domains. On a stratum A_i the order of all k + r projections,
 ties included, is locally constant, so the side of every push and the ranks
@@ -80,13 +83,15 @@ g >= 2RS / sqrt(S^2 - 4R^2), which g >= 4R / sqrt 3 satisfies for S >= 4R.
 The start, the slots and so the straight lines lie in the half-space h >= top,
 where every robot is at least z_j >= w_j from every pillar.
 (4) Gamma. Lifts and drops are along e2 in columns g >= 2R apart, slides along
-e1 in lanes c >= 2R apart, all in h >= top.
+e1 in lanes c >= 2R apart, all in h >= top; two robots in one lane keep their
+order and slide linearly between slots g apart, so they stay g >= 2R apart.
 The inverse legs are the same legs run backwards. QED.
 
 Outside the condition the plan is made all the same; the exact certificate
 (Plan.min_gap) says what it achieved and required_clearance refuses it.
 """
 
+from bisect import bisect_left
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -159,13 +164,13 @@ class DiscLayout:
         Condition (c): |p(q_j) - p(q_l)| >= w_j + w_l + 2R or
         |h(q_j) - h(q_l)| >= z_j + z_l + 2R, z the zone half-heights.
         """
-        j, l = np.triu_indices(self.reach.size, 1)
-        wide = (np.abs(self.pillar_projections[j] - self.pillar_projections[l])
-                >= self.reach[j] + self.reach[l] + 2 * robot_radius)
-        tall = (np.abs(self.pillar_offsets[j] - self.pillar_offsets[l])
-                >= self.zone[j] + self.zone[l] + 2 * robot_radius)
+        first, second = np.triu_indices(self.reach.size, 1)
+        wide = (np.abs(self.pillar_projections[first] - self.pillar_projections[second])
+                >= self.reach[first] + self.reach[second] + 2 * robot_radius)
+        tall = (np.abs(self.pillar_offsets[first] - self.pillar_offsets[second])
+                >= self.zone[first] + self.zone[second] + 2 * robot_radius)
         bad = ~(wide | tall)
-        return np.stack([j[bad], l[bad]], axis=1)
+        return np.stack([first[bad], second[bad]], axis=1)
 
 
 @dataclass(frozen=True)
@@ -217,7 +222,15 @@ def rise(configuration: np.ndarray, layout: DiscLayout) -> Rise:
     return Rise(lift, shift)
 
 
-def staging_slots(configuration: np.ndarray, layout: DiscLayout) -> np.ndarray:
+def staging_ranks(configuration: np.ndarray, layout: DiscLayout) -> np.ndarray:
+    """Return the (k,) slot of each robot: its rank by projection, ties by index."""
+    p = layout.frame.project(configuration)
+    rank = np.empty(len(p), dtype=int)
+    rank[np.lexsort((np.arange(len(p)), p))] = np.arange(len(p))
+    return rank
+
+
+def staging_slots(configuration: np.ndarray, rank: np.ndarray, layout: DiscLayout) -> np.ndarray:
     """
     Return the (k, d) slots of the staging line for configuration (k, d).
 
@@ -225,26 +238,42 @@ def staging_slots(configuration: np.ndarray, layout: DiscLayout) -> np.ndarray:
     projection, on the line at height top.
     """
     frame = layout.frame
-    p = frame.project(configuration)
-    k = len(p)
-    rank = np.empty(k)
-    rank[np.lexsort((np.arange(k), p))] = np.arange(k)
-    along = p.mean() + (rank - (k - 1) / 2) * layout.slot_spacing
+    centre = frame.project(configuration).mean()
+    along = centre + (rank - (len(rank) - 1) / 2) * layout.slot_spacing
     return frame.axis_points(along) + layout.top * frame.e2
 
 
-def lane_offsets(robot_count: int, layout: DiscLayout) -> np.ndarray:
-    """Return the (k,) e2 lifts from the staging line to robot i's lane: (i + 1) c."""
-    return (1.0 + np.arange(robot_count)) * layout.lane_pitch
+def shared_lanes(first: np.ndarray, second: np.ndarray) -> np.ndarray:
+    """
+    Return each robot's lane (0, 1, ...) for the slide from slots first to slots second.
+
+    Robots whose slots keep their order may share a lane: both slides are
+    linear between slots g apart, so they stay g apart. Patience sorting puts
+    every robot, in first-slot order, on the first lane whose last robot has a
+    smaller second slot: as few lanes as the longest run of robots whose order
+    reverses. It depends on the two rank orders only.
+    """
+    lanes = np.empty(len(first), dtype=int)
+    tops = []  # last second-slot of each lane; decreasing along the list
+    for robot in np.argsort(first):
+        target = second[robot]
+        lane = bisect_left([-top for top in tops], -target)
+        if lane == len(tops):
+            tops.append(target)
+        else:
+            tops[lane] = target
+        lanes[robot] = lane
+    return lanes
 
 
 @dataclass(frozen=True)
 class DiscSection:
-    """The breakpoints of the whole motion, their leg names and the waypoints' indices."""
+    """The breakpoints of the whole motion, leg names, waypoints' indices, lanes' e2 offsets."""
 
     positions: np.ndarray
     leg_names: tuple[str, ...]
     waypoint_indices: np.ndarray
+    lane_heights: np.ndarray
 
 
 def section(configurations: np.ndarray, layout: DiscLayout) -> DiscSection:
@@ -256,19 +285,21 @@ def section(configurations: np.ndarray, layout: DiscLayout) -> DiscSection:
     """
     n, k, _ = configurations.shape
     e2 = layout.frame.e2
-    lanes = lane_offsets(k, layout)
     deformations = []
     for configuration in configurations:
         risen = rise(configuration, layout).positions(configuration, layout.frame)
         names = [SIDESTEP] + [RISE] * (len(risen) - 2)
-        deformations.append((risen, names, staging_slots(configuration, layout)))
-    stages, names, waypoints = [configurations[0]], [], [0]
+        rank = staging_ranks(configuration, layout)
+        deformations.append((risen, names, rank, staging_slots(configuration, rank, layout)))
+    stages, names, waypoints, heights = [configurations[0]], [], [0], set()
     for m in range(n - 1):
-        risen, rise_names, slots = deformations[m]
-        back, back_names, next_slots = deformations[m + 1]
+        risen, rise_names, rank, slots = deformations[m]
+        back, back_names, next_rank, next_slots = deformations[m + 1]
+        lift = (1.0 + shared_lanes(rank, next_rank)) * layout.lane_pitch
+        heights.update((layout.top + lift).tolist())
         segment = ([(stage, name) for stage, name in zip(risen[1:], rise_names)]
-                   + [(slots, GATHER), (slots + lanes[:, None] * e2, LIFT),
-                      (next_slots + lanes[:, None] * e2, SLIDE), (next_slots, DROP),
+                   + [(slots, GATHER), (slots + lift[:, None] * e2, LIFT),
+                      (next_slots + lift[:, None] * e2, SLIDE), (next_slots, DROP),
                       (back[-1], GATHER + '^-1')]
                    + [(stage, name + '^-1')
                       for stage, name in zip(back[-2::-1], back_names[::-1])])
@@ -279,4 +310,5 @@ def section(configurations: np.ndarray, layout: DiscLayout) -> DiscSection:
             names.append(name)
         stages[-1] = configurations[m + 1]
         waypoints.append(len(stages) - 1)
-    return DiscSection(np.stack(stages), tuple(names), np.array(waypoints))
+    return DiscSection(np.stack(stages), tuple(names), np.array(waypoints),
+                       np.array(sorted(heights)))

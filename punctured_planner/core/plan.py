@@ -225,13 +225,10 @@ def _axis_plan(workspace, configurations, projections, gaps, counts):
 
 def _disc_plan(workspace, configurations, counts):
     """Return the 'discs' variant's Plan (core.discs), its legs timed by their length."""
-    n, k, _ = configurations.shape
-    layout = workspace.disc_layout
-    disc = discs.section(configurations, layout)
+    disc = discs.section(configurations, workspace.disc_layout)
     times = length_times(disc.positions, disc.waypoint_indices)
-    lanes = layout.top + discs.lane_offsets(k, layout)
     return Plan(workspace, configurations, times, disc.positions, disc.leg_names, counts,
-                lanes, None, disc.waypoint_indices)
+                disc.lane_heights, None, disc.waypoint_indices)
 
 
 def _check_required_clearance(result):
