@@ -148,12 +148,12 @@ def _coerce(spec, value):
         return tuple(items)
     if not all(_is_number(item) for item in items):
         raise ValueError('%s must be a list of numbers, got %r' % (spec.name, items))
-    items = tuple(float(item) for item in items)
-    bad = [i for i, item in enumerate(items) if not math.isfinite(item)]
+    numbers = tuple(float(item) for item in items)
+    bad = [i for i, item in enumerate(numbers) if not math.isfinite(item)]
     if bad:
         raise ValueError('%s[%d] is %r: values must be finite'
-                         % (spec.name, bad[0], items[bad[0]]))
-    return items
+                         % (spec.name, bad[0], numbers[bad[0]]))
+    return numbers
 
 
 def _check_value(spec, value):
@@ -214,7 +214,7 @@ def load_parameter_file(path, node_name=NODE_NAME):
         data = yaml.safe_load(stream) or {}
     if not isinstance(data, dict):
         raise ValueError('%s: not a ROS parameter file (a mapping of node names)' % path)
-    values = {}
+    values: dict = {}
     for key, section in data.items():
         key = str(key)
         applies = key in ('/**', '**') or key.rstrip('/').split('/')[-1] == node_name

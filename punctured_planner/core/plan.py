@@ -121,7 +121,7 @@ class Plan:
         an interval too short for its robots); the slides run in lanes
         lane_spacing apart and beyond the obstacles.
         """
-        if self.variant != 'spread':
+        if self.variant != 'spread' or self._spacing is None:
             return None
         n, k = self.configurations.shape[:2]
         singular = np.any(self.projection_counts < k + self.workspace.obstacle_count)
