@@ -13,9 +13,11 @@ Conventions:
 * Paths: one nav_msgs/Path per robot; every breakpoint of the plan is a pose
   (linear interpolation between consecutive poses is exactly the certified
   motion), with ``samples_per_leg`` extra poses evenly spaced inside every
-  leg. All robots' paths share the same stamps: start + the time
-  parameterisation at max_speed (each leg lasts long enough that its fastest
-  robot moves at max_speed).
+  leg, and no pose twice: the end of a leg in which no robot moves is left
+  out (the core's Plan.sample), so stamps strictly increase. All robots'
+  paths share the same stamps: start + the time parameterisation at
+  max_speed (each leg lasts long enough that its fastest robot moves at
+  max_speed).
 * Orientation rule: at waypoint C_m a robot has the orientation of its input
   pose in C_m; between C_m and C_{m+1} it holds the orientation of C_m (the
   last waypoint passed). A zero-length or non-finite input quaternion counts
@@ -123,37 +125,35 @@ def robot_names(configured_names, robot_count):
     return ['robot_%d' % i for i in range(robot_count)]
 
 
-def path_samples(plan, max_speed, samples_per_leg):
+def stamps_ns(start_ns, seconds):
     """
-    Return (seconds (M,), positions (M, k, d), waypoint (M,)) of the published poses.
+    Return (M,) integer stamps start_ns + seconds, strictly increasing.
 
-    Every breakpoint is a sample; ``waypoint[j]`` is the index m of the last
-    configuration C_m passed at sample j (the orientation rule).
+    Seconds round to the nearest nanosecond; where two would round to the
+    same one (a leg shorter than a nanosecond of motion), the later is put
+    1 ns after the earlier.
     """
-    seconds, positions, _ = plan.sample(samples_per_leg, max_speed=max_speed)
-    step = max(int(samples_per_leg), 0) + 1
-    waypoint_samples = np.asarray(plan.waypoint_indices) * step
-    waypoint = np.searchsorted(waypoint_samples, np.arange(seconds.size), side='right') - 1
-    return seconds, positions, waypoint
+    offsets = np.rint(np.asarray(seconds) * 1e9).astype(np.int64)
+    steps = np.arange(offsets.size, dtype=np.int64)
+    return int(start_ns) + np.maximum.accumulate(offsets - steps) + steps
 
 
-def plan_to_paths(plan, orientations, frame_id, start_ns, max_speed, samples_per_leg,
-                  plane_z=0.0):
+def plan_to_paths(samples, orientations, frame_id, start_ns, plane_z=0.0):
     """
-    Return one nav_msgs/Path per robot for ``plan`` (see the module docstring).
+    Return one nav_msgs/Path per robot for a plan's Samples (see the module docstring).
 
     orientations (n, k, 4) are the input orientations at the waypoints; start_ns
-    the stamp of the first pose. All paths share one Header object per stamp, so
-    their stamps are identical by construction.
+    the stamp of the first pose. samples is ``plan.sample(samples_per_leg,
+    max_speed)``: no pose twice, C_m exactly at ``samples.waypoints[m]``. All
+    paths share one Header object per stamp, so their stamps are identical by
+    construction.
     """
-    seconds, positions, waypoint = path_samples(plan, max_speed, samples_per_leg)
-    xyz = to_xyz(positions, plane_z)
+    xyz = to_xyz(samples.positions, plane_z)
     quaternions = normalized_quaternions(orientations)
-    offsets = np.rint(seconds * 1e9).astype(np.int64)
-    headers = [Header(frame_id=frame_id, stamp=time_from_ns(start_ns + int(offset)))
-               for offset in offsets]
+    headers = [Header(frame_id=frame_id, stamp=time_from_ns(stamp))
+               for stamp in stamps_ns(start_ns, samples.values).tolist()]
     xyz_list = xyz.transpose(1, 0, 2).tolist()
-    held = quaternions[waypoint].transpose(1, 0, 2).tolist()
+    held = quaternions[samples.last_waypoint()].transpose(1, 0, 2).tolist()
     paths = []
     for robot_xyz, robot_held in zip(xyz_list, held):
         poses = []
@@ -186,7 +186,7 @@ def empty_path(frame_id, stamp_ns):
 
 # ---------------------------------------------------------------- the response
 
-def fill_response(response, plan, paths, planning_time, max_speed):
+def fill_response(response, plan, paths, planning_time, max_speed, waypoints):
     """Fill every field of a PlanSequence response from a successful plan."""
     response.error_code = 0
     response.error_msg = ''
@@ -199,6 +199,7 @@ def fill_response(response, plan, paths, planning_time, max_speed):
     response.planning_time = duration_from_seconds(planning_time)
     response.duration = duration_from_seconds(plan.duration(max_speed))
     response.paths = paths
+    response.waypoint_indices = [int(i) for i in np.asarray(waypoints).tolist()]
     return response
 
 
@@ -217,4 +218,5 @@ def fill_error(response, code, message, planning_time=0.0, min_clearance=None):
     response.planning_time = duration_from_seconds(planning_time)
     response.duration = Duration()
     response.paths = []
+    response.waypoint_indices = []
     return response

@@ -285,10 +285,11 @@ class PlanSequenceHandler:
         start_ns = int(now_ns) + int(round(planning_time * 1e9))
         max_speed = gathered.max_speed
         self._check_duration(the_plan, max_speed, start_ns)
-        paths = conversions.plan_to_paths(the_plan, checked.orientations, settings.frame_id,
-                                          start_ns, max_speed, gathered.samples_per_leg,
-                                          settings.plane_z)
-        conversions.fill_response(response, the_plan, paths, planning_time, max_speed)
+        samples = the_plan.sample(gathered.samples_per_leg, max_speed)
+        paths = conversions.plan_to_paths(samples, checked.orientations, settings.frame_id,
+                                          start_ns, settings.plane_z)
+        conversions.fill_response(response, the_plan, paths, planning_time, max_speed,
+                                  samples.waypoints)
         return Outcome(response=response, plan=the_plan, paths=paths,
                        names=conversions.robot_names(settings.robot_names, gathered.counts[0]),
                        start_ns=start_ns, max_speed=max_speed)

@@ -42,14 +42,14 @@ def _points(xyz):
     return points
 
 
-def plan_markers(plan, frame_id, stamp_ns, plane_z=0.0, names=None):
+def plan_markers(plan, frame_id, stamp_ns, plane_z=0.0, names=None, max_speed=1.0):
     """
     Return a visualization_msgs/MarkerArray of the plan for RViz.
 
     Namespaces: a DELETEALL first (no stale markers), ``obstacles`` (black
     spheres), ``axis`` (the e1 axis, grey), ``lanes`` (one thin line per
     robot lane, a LINE_LIST), ``paths`` (one LINE_STRIP per robot through
-    every breakpoint, robot colours), ``waypoints`` (one SPHERE_LIST per
+    every breakpoint, none twice, robot colours), ``waypoints`` (one SPHERE_LIST per
     configuration C_m) and ``labels`` (robot names at C_1).
     """
     header = Header(frame_id=frame_id, stamp=time_from_ns(stamp_ns))
@@ -77,9 +77,10 @@ def plan_markers(plan, frame_id, stamp_ns, plane_z=0.0, names=None):
     lanes = to_xyz(plan.lane_segments(), plane_z).reshape(-1, 3)
     markers.append(marker('lanes', 0, Marker.LINE_LIST,
                           ColorRGBA(r=0.6, g=0.6, b=0.6, a=0.5), 0.5 * width, lanes))
+    moving = to_xyz(plan.sample(0, max_speed).positions, plane_z)
     for i in range(k):
         markers.append(marker('paths', i, Marker.LINE_STRIP, _colour(i), width,
-                              positions[:, i]))
+                              moving[:, i]))
     for m, index in enumerate(np.asarray(plan.waypoint_indices).tolist()):
         item = marker('waypoints', m, Marker.SPHERE_LIST,
                       ColorRGBA(r=1.0, g=1.0, b=1.0, a=1.0), 0.2 * scale, positions[index])
@@ -106,6 +107,6 @@ def plan_messages(outcome, settings):
                 for name, path in zip(outcome.names, outcome.paths)]
     messages.append(('plan_markers', plan_markers(outcome.plan, settings.frame_id,
                                                   outcome.start_ns, settings.plane_z,
-                                                  outcome.names)))
+                                                  outcome.names, outcome.max_speed)))
     messages.append(('domain_index', domain_index_message(outcome.plan)))
     return messages
