@@ -186,7 +186,7 @@ def empty_path(frame_id, stamp_ns):
 
 # ---------------------------------------------------------------- the response
 
-def fill_response(response, plan, paths, planning_time, max_speed, waypoints):
+def fill_response(response, plan, paths, planning_time, max_speed, waypoints, dropped=()):
     """Fill every field of a PlanSequence response from a successful plan."""
     response.error_code = 0
     response.error_msg = ''
@@ -200,6 +200,7 @@ def fill_response(response, plan, paths, planning_time, max_speed, waypoints):
     response.duration = duration_from_seconds(plan.duration(max_speed))
     response.paths = paths
     response.waypoint_indices = [int(i) for i in np.asarray(waypoints).tolist()]
+    response.dropped_configurations = [int(m) for m in dropped]
     return response
 
 
@@ -219,4 +220,5 @@ def fill_error(response, code, message, planning_time=0.0, min_clearance=None):
     response.duration = Duration()
     response.paths = []
     response.waypoint_indices = []
+    response.dropped_configurations = []
     return response

@@ -52,6 +52,7 @@ from visualization_msgs.msg import MarkerArray
 
 from . import conversions
 from . import publications
+from .core import PlanningError
 from .parameters import descriptor
 from .parameters import NODE_NAME
 from .parameters import PARAMETERS
@@ -180,13 +181,22 @@ class PlannerNode(Node):
                     lambda msg, name=name: self._on_odometry(name, msg), STATE)
 
     def _on_obstacles(self, msg):
+        """Take a new obstacle set if it can be planned in; else warn and keep the old one."""
         obstacles = ObstacleSet(conversions.obstacles_from_pose_array(msg),
                                 frame_id=msg.header.frame_id,
                                 source=self.resolve_topic_name('obstacles'),
                                 stamp_ns=conversions.stamp_to_ns(msg.header.stamp))
         with self._lock:
+            settings, previous = self._settings, self._obstacles
+        try:
+            self._handler.check_obstacles(settings, obstacles)
+        except PlanningError as error:
+            self.get_logger().warning('refused %s: %s; keeping %s' % (
+                obstacles.describe(), error, previous.describe()))
+            return
+        with self._lock:
             self._obstacles = obstacles
-        self.get_logger().debug('obstacles: %s' % obstacles.describe())
+        self.get_logger().info('obstacles: %s' % obstacles.describe())
 
     def _on_robot_states(self, msg):
         state = RobotState(conversions.pose_array_positions(msg),

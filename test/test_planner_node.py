@@ -424,3 +424,36 @@ def test_a_second_client_context_gets_the_same_latched_plan(planner, ros_client)
         assert late.last == response.paths[1]
     finally:
         other.close()
+
+
+def test_a_bad_obstacle_set_is_refused_on_arrival(planner, ros_client, monkeypatch):
+    """Issue 15.4: wrong frame or off the plane: warned and refused, the good set stays."""
+    from punctured_planner.cli import reset_obstacles
+    from punctured_planner.planner_node import LATCHED
+    _, pose_array_type, _, _, _, _ = _types()
+    node = planner(obstacles=flat(OBSTACLES))
+    checked = []
+    original = node.node._handler.check_obstacles
+
+    def spy(settings, obstacles):
+        checked.append(obstacles)
+        return original(settings, obstacles)
+    monkeypatch.setattr(node.node._handler, 'check_obstacles', spy)
+    publisher = ros_client.node.create_publisher(pose_array_type, node.name('obstacles'),
+                                                 LATCHED)
+    for bad in (pose_array(OBSTACLES, frame_id='odom'),
+                pose_array([[0.0, 0.0, 0.3], [1.0, 0.0, 0.0]])):
+        count = len(checked)
+        publisher.publish(bad)
+        assert ros_client.spin_until(lambda: len(checked) > count, 10)
+        assert node.node.snapshot().obstacles.source == 'parameter'
+    good = [[5.0, 5.0, 0.0]]
+    publisher.publish(pose_array(good))
+    assert ros_client.spin_until(
+        lambda: node.node.snapshot().obstacles.source.endswith('/obstacles'), 10)
+    assert np.array_equal(node.node.snapshot().obstacles.points, good)
+    # Back to the parameter's set without `ros2 param set` (punctured-planner reset-obstacles).
+    assert reset_obstacles(ros_client.node, ros_client.executor, node.name('planner_node'),
+                           10.0) is None
+    assert node.node.snapshot().obstacles.source == 'parameter'
+    assert np.array_equal(node.node.snapshot().obstacles.points, OBSTACLES)
