@@ -373,8 +373,10 @@ class PlanSequenceHandler:
         if samples > MAX_SAMPLES_PER_LEG:
             _fail(ErrorCode.REQUEST_OVER_LIMITS, 'samples_per_leg %d is more than %d'
                   % (samples, MAX_SAMPLES_PER_LEG))
-        breakpoints = SCHEDULES[settings.variant].breakpoint_count(n)
-        poses = k * ((breakpoints - 1) * (samples + 1) + 1)
+        schedule = SCHEDULES.get(settings.variant)
+        if schedule is None:
+            return  # no fixed legs ('discs'): its breakpoints are known only once planned
+        poses = k * ((schedule.breakpoint_count(n) - 1) * (samples + 1) + 1)
         if poses > settings.max_poses:
             _fail(ErrorCode.REQUEST_OVER_LIMITS, 'the answer would hold %d poses (%d robots x '
                   '%d poses), more than max_poses %d' % (poses, k, poses // max(k, 1),
