@@ -214,7 +214,9 @@ def test_every_error_code_and_the_node_keeps_serving(planner, ros_client, monkey
 
     assert all(r.successful
                for r in node.set_parameters(obstacles=flat(OBSTACLES + OBSTACLES[:1])))
-    expect(make_request(), codes.OBSTACLES_DEGENERATE, 'obstacles 0 and 3')
+    expect(make_request(), codes.OBSTACLES_DEGENERATE,
+           'obstacle 0 at (-2, 0.5, 0) (from the parameter) and obstacle 3 at (-2, 0.5, 0) '
+           '(from the parameter) are at the same point')
     node.set_parameters(obstacles=flat(OBSTACLES))
     valid()
 

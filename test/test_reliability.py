@@ -58,6 +58,8 @@ PARAMETERS = {
     'obstacles': [v for point in OBSTACLES for v in point], 'variant': 'spread',
     'lane_spacing': 1.0, 'min_spacing': 0.5, 'required_clearance': 0.0, 'max_speed': 0.5,
     'samples_per_leg': 0, 'max_robots': 16, 'max_configurations': 8, 'max_poses': 5000,
+    # The fuzz publishes the robot state once and plans from it for seconds.
+    'max_state_age': 0.0,
 }
 MAX_SAMPLES_PER_LEG = 1000  # msg_docs/parameters.md: samples_per_leg range
 PLANE_TOLERANCE = 1e-9  # msg_docs: z must equal plane_z within 1e-9
@@ -510,7 +512,8 @@ def test_the_limit_check_runs_before_any_conversion(monkeypatch):
     snapshot = planning.Snapshot(settings, planning.ObstacleSet(np.asarray(OBSTACLES)), None)
     for name, spec in over_limit_specs():
         if spec['use_current_state']:
-            state = planning.RobotState(np.asarray(CONFIGURATIONS[0]), np.zeros((4, 4)))
+            state = planning.RobotState(np.asarray(CONFIGURATIONS[0]), np.zeros((4, 4)),
+                                        received_ns=time.time_ns())
             snapshot = planning.Snapshot(settings, snapshot.obstacles, state)
         response = service_type().Response()
         planning.PlanSequenceHandler().handle(build_request(spec), response, snapshot,
