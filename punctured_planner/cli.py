@@ -94,6 +94,61 @@ def _call(args):
         rclpy.try_shutdown(context=context)
 
 
+def reset_obstacles(node, executor, planner_node, timeout_sec):
+    """
+    Make a running planner go back to its obstacles parameter; return an error text or None.
+
+    Sets the node's ``obstacles`` parameter to its current value through the
+    parameter services: the latest source wins, so the parameter's set replaces
+    a set that came on the ``obstacles`` topic (one that outlived its publisher).
+    """
+    from rclpy.parameter import Parameter
+    from rclpy.parameter_client import AsyncParameterClient
+
+    remote = AsyncParameterClient(node, planner_node)
+    if not remote.wait_for_services(timeout_sec=timeout_sec):
+        return 'parameter services of %s not available' % planner_node
+
+    def wait(future):
+        deadline = time.monotonic() + timeout_sec
+        while not future.done() and time.monotonic() < deadline:
+            executor.spin_once(timeout_sec=0.1)
+        return future.result() if future.done() else None
+
+    got = wait(remote.get_parameters(['obstacles']))
+    if got is None or not got.values:
+        return 'no obstacles parameter on %s' % planner_node
+    values = list(got.values[0].double_array_value)
+    done = wait(remote.set_parameters(
+        [Parameter('obstacles', Parameter.Type.DOUBLE_ARRAY, values)]))
+    if done is None or not done.results[0].successful:
+        return 'setting obstacles on %s failed%s' % (
+            planner_node, ': ' + done.results[0].reason if done is not None else '')
+    return None
+
+
+def _reset(args):
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+
+    context = rclpy.context.Context()
+    rclpy.init(context=context)
+    executor = SingleThreadedExecutor(context=context)
+    node = rclpy.create_node('punctured_planner_cli', context=context)
+    executor.add_node(node)
+    try:
+        problem = reset_obstacles(node, executor, args.node, args.wait)
+    finally:
+        executor.shutdown()
+        node.destroy_node()
+        rclpy.try_shutdown(context=context)
+    if problem:
+        print('punctured-planner: %s' % problem, file=sys.stderr)
+        return EXIT_NO_SERVICE
+    print('# %s plans among its obstacles parameter again' % args.node, file=sys.stderr)
+    return EXIT_OK
+
+
 def print_response(response, no_paths=False):
     """Print a PlanSequence response as YAML (code name on stderr); return the exit code."""
     from punctured_planner.msg_dict import constant_names
@@ -123,7 +178,7 @@ def offline_plan(request, settings, now_ns=None):
     """
     from punctured_planner import conversions
     from punctured_planner.planning import ObstacleSet
-    from punctured_planner.planning import Planner
+    from punctured_planner.planning import PlanSequenceHandler
     from punctured_planner.planning import Snapshot
     from punctured_planner_interfaces.srv import PlanSequence
 
@@ -131,7 +186,7 @@ def offline_plan(request, settings, now_ns=None):
         settings, ObstacleSet(conversions.obstacles_from_parameter(settings.obstacles)),
         state=None, state_problem='punctured-planner plan has no robot state (no ROS graph)')
     now_ns = time.time_ns() if now_ns is None else now_ns
-    return Planner().handle(request, PlanSequence.Response(), snapshot, now_ns)
+    return PlanSequenceHandler().handle(request, PlanSequence.Response(), snapshot, now_ns)
 
 
 def _plan(args):
@@ -189,6 +244,14 @@ def make_parser(pictures=True):
     call.add_argument('--no-paths', action='store_true',
                       help='print only the number of paths, not the poses')
     call.set_defaults(func=_call)
+    reset = commands.add_parser(
+        'reset-obstacles', help="go back to the node's obstacles parameter, replacing a set "
+        "that came on the 'obstacles' topic")
+    reset.add_argument('--node', default='/planner_node',
+                       help='the planner node (default: %(default)s)')
+    reset.add_argument('--wait', type=float, default=10.0,
+                       help='seconds to wait for the node (default: %(default)s)')
+    reset.set_defaults(func=_reset)
     plan = commands.add_parser(
         'plan', help='plan a request (YAML file) offline, without a ROS graph, and print '
         'the response; optionally draw or record the plan')
@@ -211,7 +274,7 @@ def make_parser(pictures=True):
 def main(argv=None):
     """Entry point of the ``punctured-planner`` console script."""
     argv = sys.argv[1:] if argv is None else list(argv)
-    args = make_parser(pictures=argv[:1] != ['call']).parse_args(argv)
+    args = make_parser(pictures=argv[:1] == ['plan']).parse_args(argv)
     try:
         return args.func(args)
     except KeyboardInterrupt:

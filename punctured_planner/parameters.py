@@ -71,6 +71,15 @@ PARAMETERS = (
     Spec('required_clearance', 'double', 0.0,
          'Refuse a plan whose certified minimum clearance is below this (m); 0 accepts '
          'every collision-free plan.', low=0.0, high=1e6),
+    Spec('max_state_age', 'double', 0.5,
+         'Largest age (s, by arrival on the node clock) of the robot state a '
+         'use_current_state request may start from; older is refused (NO_ROBOT_STATE). '
+         '0 switches the check off: unsafe, a robot may be planned from where it was.',
+         low=0.0, high=1e6),
+    Spec('repeat_tolerance', 'double', 1e-3,
+         'With use_current_state, leading request configurations whose every robot is '
+         'within this distance (m) of the current state are dropped before planning '
+         '(reported in dropped_configurations).', low=0.0, high=1e6),
     Spec('max_speed', 'double', 1.0,
          "Speed of the fastest robot on each leg (m/s) when a request's max_speed is "
          '<= 0.', low=1e-6, high=1e6),
@@ -104,6 +113,8 @@ class Settings:
     lane_spacing: float = 1.0
     min_spacing: float = 0.5
     required_clearance: float = 0.0
+    max_state_age: float = 0.5
+    repeat_tolerance: float = 1e-3
     max_speed: float = 1.0
     samples_per_leg: int = 0
     max_robots: int = 10000
@@ -148,12 +159,12 @@ def _coerce(spec, value):
         return tuple(items)
     if not all(_is_number(item) for item in items):
         raise ValueError('%s must be a list of numbers, got %r' % (spec.name, items))
-    items = tuple(float(item) for item in items)
-    bad = [i for i, item in enumerate(items) if not math.isfinite(item)]
+    numbers = tuple(float(item) for item in items)
+    bad = [i for i, item in enumerate(numbers) if not math.isfinite(item)]
     if bad:
         raise ValueError('%s[%d] is %r: values must be finite'
-                         % (spec.name, bad[0], items[bad[0]]))
-    return items
+                         % (spec.name, bad[0], numbers[bad[0]]))
+    return numbers
 
 
 def _check_value(spec, value):
@@ -214,7 +225,7 @@ def load_parameter_file(path, node_name=NODE_NAME):
         data = yaml.safe_load(stream) or {}
     if not isinstance(data, dict):
         raise ValueError('%s: not a ROS parameter file (a mapping of node names)' % path)
-    values = {}
+    values: dict = {}
     for key, section in data.items():
         key = str(key)
         applies = key in ('/**', '**') or key.rstrip('/').split('/')[-1] == node_name

@@ -3,7 +3,7 @@ The planner node: topics and parameters in, PlanSequence service, a Path per rob
 
 A thin adapter: it keeps the latest obstacles, robot state and parameters under
 one lock, takes one snapshot of them per request (logged with its stamps),
-hands request and snapshot to :class:`punctured_planner.planning.Planner` (the
+hands request and snapshot to :class:`punctured_planner.planning.PlanSequenceHandler` (the
 checks and the core) and publishes the result. No math here; every message
 conversion is in :mod:`punctured_planner.conversions`.
 
@@ -27,6 +27,7 @@ ms median with stalls of 2-6 s (two single-threaded executors: 3.4 ms, worst 6
 ms). A plan is published only once it is complete.
 """
 
+from dataclasses import dataclass
 import sys
 import threading
 import traceback
@@ -50,15 +51,29 @@ from std_msgs.msg import UInt32
 from visualization_msgs.msg import MarkerArray
 
 from . import conversions
+from . import publications
+from .core import PlanningError
 from .parameters import descriptor
 from .parameters import NODE_NAME
 from .parameters import PARAMETERS
 from .parameters import settings_from_values
 from .parameters import SPECS
 from .planning import ObstacleSet
-from .planning import Planner
+from .planning import PlanSequenceHandler
 from .planning import RobotState
 from .planning import Snapshot
+
+
+@dataclass(frozen=True, eq=False)
+class OdometryEntry:
+    """The last odometry of one robot: pose, frame, stamp and arrival time (node clock)."""
+
+    position: np.ndarray
+    orientation: np.ndarray
+    frame_id: str
+    stamp_ns: int
+    received_ns: int
+
 
 LATCHED = QoSProfile(depth=1, history=HistoryPolicy.KEEP_LAST,
                      reliability=ReliabilityPolicy.RELIABLE,
@@ -76,7 +91,7 @@ class PlannerNode(Node):
         """Declare the parameters, subscribe, advertise; raise ValueError for bad parameters."""
         super().__init__(NODE_NAME, **kwargs)
         self._lock = threading.Lock()
-        self._planner = Planner()
+        self._handler = PlanSequenceHandler()
         self._request_count = 0
         for spec in PARAMETERS:
             self.declare_parameter(spec.name, spec.default, descriptor(spec))
@@ -84,8 +99,8 @@ class PlannerNode(Node):
         self.add_on_set_parameters_callback(self._on_set_parameters)
         self.add_post_set_parameters_callback(self._after_set_parameters)
         self._obstacles = self._parameter_obstacles(self._settings)
-        self._robot_states = None  # (RobotState, received_ns)
-        self._odometry = {}  # name -> (position, orientation, frame_id, stamp_ns, received_ns)
+        self._robot_states: RobotState | None = None
+        self._odometry: dict[str, OdometryEntry] = {}
 
         # The subscriptions' own node: spun apart from the service (module docstring).
         # A local __node remap outranks a global one (-r __node:=NAME, launch name=).
@@ -130,7 +145,7 @@ class PlannerNode(Node):
         """Take the accepted values into the settings the next request will use."""
         try:
             self._apply_parameters(parameters)
-        except Exception as error:  # noqa: B902 - a parameter change never stops the node
+        except Exception as error:  # a parameter change never stops the node
             self.get_logger().error('applying parameters failed: %r' % error)
 
     def _apply_parameters(self, parameters):
@@ -166,26 +181,36 @@ class PlannerNode(Node):
                     lambda msg, name=name: self._on_odometry(name, msg), STATE)
 
     def _on_obstacles(self, msg):
+        """Take a new obstacle set if it can be planned in; else warn and keep the old one."""
         obstacles = ObstacleSet(conversions.obstacles_from_pose_array(msg),
                                 frame_id=msg.header.frame_id,
                                 source=self.resolve_topic_name('obstacles'),
                                 stamp_ns=conversions.stamp_to_ns(msg.header.stamp))
         with self._lock:
+            settings, previous = self._settings, self._obstacles
+        try:
+            self._handler.check_obstacles(settings, obstacles)
+        except PlanningError as error:
+            self.get_logger().warning('refused %s: %s; keeping %s' % (
+                obstacles.describe(), error, previous.describe()))
+            return
+        with self._lock:
             self._obstacles = obstacles
-        self.get_logger().debug('obstacles: %s' % obstacles.describe())
+        self.get_logger().info('obstacles: %s' % obstacles.describe())
 
     def _on_robot_states(self, msg):
         state = RobotState(conversions.pose_array_positions(msg),
                            conversions.pose_array_orientations(msg), msg.header.frame_id,
-                           conversions.stamp_to_ns(msg.header.stamp), 'robot_states')
-        received = self.get_clock().now().nanoseconds
+                           conversions.stamp_to_ns(msg.header.stamp), 'robot_states',
+                           self.get_clock().now().nanoseconds)
         with self._lock:
-            self._robot_states = (state, received)
+            self._robot_states = state
 
     def _on_odometry(self, name, msg):
         position, orientation = conversions.odometry_pose(msg)
-        entry = (position, orientation, msg.header.frame_id,
-                 conversions.stamp_to_ns(msg.header.stamp), self.get_clock().now().nanoseconds)
+        entry = OdometryEntry(position, orientation, msg.header.frame_id,
+                              conversions.stamp_to_ns(msg.header.stamp),
+                              self.get_clock().now().nanoseconds)
         with self._lock:
             # A late message for a robot just removed from robot_names is dropped.
             if name in self._settings.robot_names:
@@ -195,19 +220,20 @@ class PlannerNode(Node):
         """Return (RobotState or None, why none); call with the lock held."""
         candidates = []
         if self._robot_states is not None:
-            candidates.append((self._robot_states[1], self._robot_states[0]))
+            candidates.append(self._robot_states)
         names = settings.robot_names
         missing = [name for name in names if name not in self._odometry]
         if names and not missing:
             entries = [self._odometry[name] for name in names]
-            frames = [e[2] for e in entries]
+            frames = [e.frame_id for e in entries]
             frame = next((f for f in frames if f and f != settings.frame_id), frames[0])
-            state = RobotState(np.stack([e[0] for e in entries]),
-                               np.stack([e[1] for e in entries]), frame,
-                               min(e[3] for e in entries), 'odometry of %s' % ', '.join(names))
-            candidates.append((min(e[4] for e in entries), state))
+            candidates.append(RobotState(
+                np.stack([e.position for e in entries]),
+                np.stack([e.orientation for e in entries]), frame,
+                min(e.stamp_ns for e in entries), 'odometry of %s' % ', '.join(names),
+                min(e.received_ns for e in entries)))
         if candidates:
-            return max(candidates, key=lambda c: c[0])[1], ''
+            return max(candidates, key=lambda state: state.received_ns), ''
         problem = 'no robot state received yet (topic robot_states'
         if names:
             problem += ', or odometry from %s' % ', '.join(n + '/odom' for n in missing)
@@ -232,11 +258,11 @@ class PlannerNode(Node):
                     % (number, len(request.configurations),
                        ' + current state' if request.use_current_state else '',
                        snapshot.describe()))
-        outcome = self._planner.handle(request, response, snapshot, now_ns)
+        outcome = self._handler.handle(request, response, snapshot, now_ns)
         if outcome.ok:
             try:
                 self._publish(outcome, snapshot.settings)
-            except Exception as error:  # noqa: B902 - never crash the service
+            except Exception as error:  # never crash the service
                 logger.error('plan_sequence #%d: publishing failed: %r' % (number, error))
                 conversions.fill_error(response, PlanSequence.Response.UNKNOWN,
                                        'internal error while publishing: %s' % error)
@@ -259,7 +285,7 @@ class PlannerNode(Node):
 
     def _publish(self, outcome, settings):
         """Publish the complete plan: every robot's Path, stale robots emptied, markers, index."""
-        messages = conversions.plan_messages(outcome, settings)
+        messages = publications.plan_messages(outcome, settings)
         publishers = [self._publisher(topic, type(message)) for topic, message in messages]
         stale = [name for name in self._latched_names if name not in set(outcome.names)]
         for publisher, (_, message) in zip(publishers, messages):
@@ -280,7 +306,7 @@ class PlannerNode(Node):
             for name in names:
                 self._publisher(name + '/plan', Path).publish(
                     conversions.empty_path(settings.frame_id, self.get_clock().now().nanoseconds))
-        except Exception as error:  # noqa: B902 - the service answers UNKNOWN regardless
+        except Exception as error:  # the service answers UNKNOWN regardless
             self.get_logger().error('could not retract the partial plan: %r' % error)
 
     def _publisher(self, topic, msg_type):

@@ -155,7 +155,6 @@ def record_plan(path, outcome, settings):
         'max_speed': outcome.max_speed, 'robots': ','.join(outcome.names),
         'projection_counts': ','.join(str(int(c)) for c in p.projection_counts),
     }
-    from . import conversions
-    messages = [('/' + topic, message)
-                for topic, message in conversions.plan_messages(outcome, settings)]
+    from .publications import plan_messages
+    messages = [('/' + topic, message) for topic, message in plan_messages(outcome, settings)]
     return write_mcap(path, messages, outcome.start_ns, metadata)

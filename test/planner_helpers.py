@@ -121,10 +121,20 @@ def wait_for(predicate, timeout_sec=10.0, what='condition'):
         time.sleep(0.01)
 
 
+def path_positions(path):
+    """Return the positions of a nav_msgs/Path as an (M, 3) array."""
+    return np.array([(p.pose.position.x, p.pose.position.y, p.pose.position.z)
+                     for p in path.poses], dtype=float).reshape(-1, 3)
+
+
+def path_stamps_ns(path):
+    """Return the stamps of a nav_msgs/Path's poses as an (M,) integer array (ns)."""
+    from punctured_planner.conversions import stamp_to_ns
+    return np.array([stamp_to_ns(p.header.stamp) for p in path.poses], dtype=np.int64)
+
+
 def path_array(path):
     """Return (positions (M, 3), stamps_ns (M,)) of a nav_msgs/Path."""
-    from punctured_planner.conversions import path_positions
-    from punctured_planner.conversions import path_stamps_ns
     return path_positions(path), path_stamps_ns(path)
 
 

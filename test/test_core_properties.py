@@ -15,7 +15,7 @@ VARIANTS = st.sampled_from(['paper', 'spread'])
 
 def dense_minimum(p, samples_per_leg=40):
     """Return the smallest pairwise and robot-obstacle distance over dense samples."""
-    _, positions, _ = p.sample(samples_per_leg)
+    positions = p.sample(samples_per_leg).positions
     smallest = np.inf
     k = positions.shape[1]
     if k > 1:

@@ -46,10 +46,12 @@ EXPECTED_RESPONSE_FIELDS = {
     'sequential_complexity': 'uint32',
     'optimal': 'boolean',
     'projection_counts': 'sequence<uint32>',
+    'dropped_configurations': 'sequence<uint32>',
     'min_clearance': 'double',
     'planning_time': 'builtin_interfaces/Duration',
     'duration': 'builtin_interfaces/Duration',
     'paths': 'sequence<nav_msgs/Path>',
+    'waypoint_indices': 'sequence<uint32>',
 }
 
 

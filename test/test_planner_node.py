@@ -108,14 +108,15 @@ def test_topics_in_one_path_per_robot_out(planner, ros_client):
         assert path == response.paths[i]
         assert path.header.frame_id == 'map'
         positions, stamps = path_array(path)
-        # every breakpoint is a pose, exactly; z back on the plane
-        assert np.array_equal(positions[:, :2], expected.positions[:, i])
+        # every distinct breakpoint is a pose, exactly; z back on the plane
+        assert np.array_equal(positions[:, :2], expected.sample(0, 0.5).positions[:, i])
         assert np.all(positions[:, 2] == 0.0)
         if first_stamps is None:
             first_stamps = stamps
         assert np.array_equal(stamps, first_stamps), 'robots must share their stamps'
     assert first_stamps[0] >= before
-    assert np.allclose(first_stamps - first_stamps[0], expected.stamps(0.5) * 1e9, atol=2)
+    assert np.allclose(first_stamps - first_stamps[0], expected.sample(0, 0.5).values * 1e9,
+                       atol=2)
     assert domain.last.data == expected.domain_index
     namespaces = {}
     for marker in markers.last.markers:
@@ -213,7 +214,9 @@ def test_every_error_code_and_the_node_keeps_serving(planner, ros_client, monkey
 
     assert all(r.successful
                for r in node.set_parameters(obstacles=flat(OBSTACLES + OBSTACLES[:1])))
-    expect(make_request(), codes.OBSTACLES_DEGENERATE, 'obstacles 0 and 3')
+    expect(make_request(), codes.OBSTACLES_DEGENERATE,
+           'obstacle 0 at (-2, 0.5, 0) (from the parameter) and obstacle 3 at (-2, 0.5, 0) '
+           '(from the parameter) are at the same point')
     node.set_parameters(obstacles=flat(OBSTACLES))
     valid()
 
@@ -247,14 +250,16 @@ def test_parameter_changes_take_effect_and_bad_values_are_refused(planner, ros_c
         assert response.error_code == plan_sequence.Response.NONE, response.error_msg
         return response
 
-    assert len(call().paths[0].poses) == 2 * 9 + 1  # spread: 9 legs per segment
+    assert len(call().paths[0].poses) == core_plan().sample(0, 1.0).values.size
     assert all(r.successful for r in node.set_parameters(variant='paper'))
     response = call()
     paper = core_plan(variant='paper')
-    assert np.array_equal(path_array(response.paths[1])[0][:, :2], paper.positions[:, 1])
+    assert np.array_equal(path_array(response.paths[1])[0][:, :2],
+                          paper.sample(0, 1.0).positions[:, 1])
     node.set_parameters(samples_per_leg=2)
-    assert len(call().paths[0].poses) == 2 * 7 * 3 + 1
-    assert len(call(make_request(samples_per_leg=0)).paths[0].poses) == 2 * 7 + 1
+    assert len(call().paths[0].poses) == paper.sample(2, 1.0).values.size
+    assert len(call(make_request(samples_per_leg=0)).paths[0].poses) == \
+        paper.sample(0, 1.0).values.size
     node.set_parameters(max_speed=2.0, samples_per_leg=0)
     response = call()
     assert response.duration.sec + response.duration.nanosec * 1e-9 == pytest.approx(
@@ -271,7 +276,7 @@ def test_parameter_changes_take_effect_and_bad_values_are_refused(planner, ros_c
     lifted[1, :, 2] = [0.5, -0.5, 1.0, 2.0]
     positions = path_array(call(make_request(lifted)).paths[3])[0]
     assert np.array_equal(positions, core_plan(lifted, variant='paper', lane_spacing=2.5,
-                                               dimension=3).positions[:, 3])
+                                               dimension=3).sample(0, 2.0).positions[:, 3])
     node.set_parameters(dimension=2, plane_z=1.5)
     assert ros_client.call(client, make_request()).error_code == \
         plan_sequence.Response.OFF_PLANE  # the obstacles (z = 0) are off the plane too
@@ -421,3 +426,36 @@ def test_a_second_client_context_gets_the_same_latched_plan(planner, ros_client)
         assert late.last == response.paths[1]
     finally:
         other.close()
+
+
+def test_a_bad_obstacle_set_is_refused_on_arrival(planner, ros_client, monkeypatch):
+    """Issue 15.4: wrong frame or off the plane: warned and refused, the good set stays."""
+    from punctured_planner.cli import reset_obstacles
+    from punctured_planner.planner_node import LATCHED
+    _, pose_array_type, _, _, _, _ = _types()
+    node = planner(obstacles=flat(OBSTACLES))
+    checked = []
+    original = node.node._handler.check_obstacles
+
+    def spy(settings, obstacles):
+        checked.append(obstacles)
+        return original(settings, obstacles)
+    monkeypatch.setattr(node.node._handler, 'check_obstacles', spy)
+    publisher = ros_client.node.create_publisher(pose_array_type, node.name('obstacles'),
+                                                 LATCHED)
+    for bad in (pose_array(OBSTACLES, frame_id='odom'),
+                pose_array([[0.0, 0.0, 0.3], [1.0, 0.0, 0.0]])):
+        count = len(checked)
+        publisher.publish(bad)
+        assert ros_client.spin_until(lambda: len(checked) > count, 10)
+        assert node.node.snapshot().obstacles.source == 'parameter'
+    good = [[5.0, 5.0, 0.0]]
+    publisher.publish(pose_array(good))
+    assert ros_client.spin_until(
+        lambda: node.node.snapshot().obstacles.source.endswith('/obstacles'), 10)
+    assert np.array_equal(node.node.snapshot().obstacles.points, good)
+    # Back to the parameter's set without `ros2 param set` (punctured-planner reset-obstacles).
+    assert reset_obstacles(ros_client.node, ros_client.executor, node.name('planner_node'),
+                           10.0) is None
+    assert node.node.snapshot().obstacles.source == 'parameter'
+    assert np.array_equal(node.node.snapshot().obstacles.points, OBSTACLES)

@@ -46,7 +46,8 @@ def test_default_scenario_across_processes(planner_process, ros_client, ros_env)
     assert response.domain_index == expected.domain_index
     assert len(response.paths) == 4
     for i, path in enumerate(response.paths):
-        assert np.array_equal(path_array(path)[0][:, :2], expected.positions[:, i])
+        assert np.array_equal(path_array(path)[0][:, :2],
+                              expected.sample(0, 0.5).positions[:, i])
     # waypoint C_3 carries the request's orientation (yaw 90 degrees)
     final = response.paths[0].poses[-1].pose.orientation
     assert final.z == pytest.approx(0.7071067811865476) and final.w == pytest.approx(

@@ -12,10 +12,10 @@ is doc/design.md.
 
 from .certificate import Clearance
 from .errors import ErrorCode, PlanningError
-from .plan import Plan, plan
+from .plan import Plan, plan, Samples
 from .sections import Schedule, SCHEDULES, VARIANTS
 from .space import Frame, Workspace
 from .validation import first_out_of_range, MAX_COORDINATE
 
 __all__ = ['Clearance', 'ErrorCode', 'first_out_of_range', 'Frame', 'MAX_COORDINATE', 'Plan',
-           'PlanningError', 'Schedule', 'SCHEDULES', 'VARIANTS', 'Workspace', 'plan']
+           'PlanningError', 'Samples', 'Schedule', 'SCHEDULES', 'VARIANTS', 'Workspace', 'plan']

@@ -165,6 +165,7 @@ def _sweep_pairs(start, end, bound):
         counts = np.maximum(ends - np.arange(order.size) - 1, 0)
         if best is None or counts.sum() < best[2].sum():
             best = (order, ends, counts)
+    assert best is not None  # d >= 1 axes
     order, ends, counts = best
     first = np.repeat(np.arange(order.size), counts)
     offsets = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)

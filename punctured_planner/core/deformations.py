@@ -10,7 +10,6 @@ The deformations that carry any configuration onto the axis: D, S and phi.
 """
 
 import numpy as np
-import numpy.typing as npt
 
 try:
     from scipy.optimize import isotonic_regression
@@ -18,7 +17,7 @@ except ImportError:  # SciPy < 1.12: Ubuntu 24.04's python3-scipy (ROS 2 Jazzy) 
     isotonic_regression = None
 
 
-def pool_adjacent_violators(values: npt.ArrayLike) -> np.ndarray:
+def pool_adjacent_violators(values: np.ndarray) -> np.ndarray:
     """
     Return the non-decreasing least-squares fit of values (unit weights).
 

@@ -9,6 +9,7 @@ and all robots switch legs together, so the motion is the piecewise-linear
 interpolation of its breakpoints, stored exactly.
 """
 
+from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
@@ -25,6 +26,27 @@ from .space import Workspace
 from .strata import epsilon, projection_count, projection_gaps
 from .timing import breakpoint_stamps, length_times, resample
 from .validation import validate_configurations
+
+
+@dataclass(frozen=True, eq=False)
+class Samples:
+    """
+    The poses of a plan as a robot gets them: one shared list of times, no pose twice.
+
+    values (M,) are stamps in seconds (or parameters tau), positions (M, k, d);
+    ``waypoints[m]`` is the index of the pose at C_m, which is present exactly.
+    A breakpoint that repeats the previous one's time and positions (the end
+    of a leg in which no robot moves) is left out, so stamps strictly increase
+    wherever the robots move (doc/design.md section 8).
+    """
+
+    values: np.ndarray
+    positions: np.ndarray
+    waypoints: np.ndarray
+
+    def last_waypoint(self) -> np.ndarray:
+        """Return (M,) the index m of the last configuration C_m passed at each pose."""
+        return np.searchsorted(self.waypoints, np.arange(self.values.size), side='right') - 1
 
 
 class Plan:
@@ -121,7 +143,7 @@ class Plan:
         an interval too short for its robots); the slides run in lanes
         lane_spacing apart and beyond the obstacles.
         """
-        if self.variant != 'spread':
+        if self.variant != 'spread' or self._spacing is None:
             return None
         n, k = self.configurations.shape[:2]
         singular = np.any(self.projection_counts < k + self.workspace.obstacle_count)
@@ -166,15 +188,22 @@ class Plan:
         """Return the duration in seconds of the whole motion at max_speed."""
         return float(self.stamps(max_speed)[-1])
 
-    def sample(self, samples_per_leg: int, max_speed: float | None = None
-               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def sample(self, samples_per_leg: int, max_speed: float | None = None) -> Samples:
         """
-        Return (values, positions, is_breakpoint) with extra samples inside every leg.
+        Return the Samples: every distinct breakpoint and samples_per_leg more inside each leg.
 
         values are stamps in seconds when max_speed is given, else parameters tau.
+        In stamps a leg where no robot moves lasts no time, so its end repeats its
+        start and is left out; in tau it still takes its share of [0, 1].
         """
         values = self.times if max_speed is None else self.stamps(max_speed)
-        return resample(values, self.positions, samples_per_leg)
+        new = np.ones(values.size, dtype=bool)
+        new[1:] = (values[1:] != values[:-1]) | np.any(
+            self.positions[1:] != self.positions[:-1], axis=(1, 2))
+        values, positions, _ = resample(values[new], self.positions[new], samples_per_leg)
+        kept = np.cumsum(new) - 1
+        step = max(int(samples_per_leg), 0) + 1
+        return Samples(values, positions, kept[self.waypoint_indices] * step)
 
 
 def plan(workspace: Workspace, configurations: npt.ArrayLike, certify: bool = True) -> Plan:

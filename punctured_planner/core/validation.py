@@ -151,11 +151,12 @@ def _coincidences(configurations, obstacles):
             m, pair = int(hits[0][0]), robot_pairs + int(hits[0][1])
             on = (m, int(a[pair]), int(b[pair]) - k)
         return robots, on
-    on = None
     if r:
         hits = np.argwhere(np.all(configurations[:, :, None, :] == obstacles[None, None], axis=3))
-        on = tuple(int(v) for v in hits[0]) if hits.size else None
-    return _sorted_coincidence(configurations), on
+        if hits.size:
+            m, robot, obstacle = (int(v) for v in hits[0])
+            return _sorted_coincidence(configurations), (m, robot, obstacle)
+    return _sorted_coincidence(configurations), None
 
 
 def _first_overlap(configurations, obstacles, robot_radius, obstacle_radii):
@@ -199,18 +200,18 @@ def validate_configurations(configurations: npt.ArrayLike, obstacles: np.ndarray
     With radii, robot discs that overlap (ROBOTS_COINCIDE) and a robot disc that
     overlaps an obstacle's (ROBOT_ON_OBSTACLE) are refused too.
     """
-    configurations, all_finite = _as_array(configurations, obstacles.shape[1])
+    checked, all_finite = _as_array(configurations, obstacles.shape[1])
     if not all_finite:
-        m, robot, axis = (int(v) for v in np.argwhere(~np.isfinite(configurations))[0])
+        m, robot, axis = (int(v) for v in np.argwhere(~np.isfinite(checked))[0])
         raise PlanningError(ErrorCode.NON_FINITE_VALUE,
                             f'configuration {m}, robot {robot}: coordinate {axis} is '
-                            f'{configurations[m, robot, axis]}', configuration=m, robots=[robot])
-    coincident, on_obstacle = _coincidences(configurations, obstacles)
+                            f'{checked[m, robot, axis]}', configuration=m, robots=[robot])
+    coincident, on_obstacle = _coincidences(checked, obstacles)
     if coincident is not None:
         m, a, b = coincident
         raise PlanningError(ErrorCode.ROBOTS_COINCIDE,
                             f'configuration {m}: robots {a} and {b} are at the same point '
-                            f'{configurations[m, a].tolist()}', configuration=m, robots=[a, b])
+                            f'{checked[m, a].tolist()}', configuration=m, robots=[a, b])
     if on_obstacle is not None:
         m, robot, obstacle = on_obstacle
         raise PlanningError(ErrorCode.ROBOT_ON_OBSTACLE,
@@ -219,7 +220,7 @@ def validate_configurations(configurations: npt.ArrayLike, obstacles: np.ndarray
                             robots=[robot], obstacle=obstacle)
     if obstacle_radii is None:
         obstacle_radii = np.zeros(len(obstacles))
-    overlap, on_obstacle = _first_overlap(configurations, obstacles, robot_radius,
+    overlap, on_obstacle = _first_overlap(checked, obstacles, robot_radius,
                                           obstacle_radii)
     if overlap is not None:
         m, a, b, distance = overlap
@@ -235,4 +236,4 @@ def validate_configurations(configurations: npt.ArrayLike, obstacles: np.ndarray
                             f'apart, less than robot_radius + obstacle_radius = '
                             f'{robot_radius + obstacle_radii[obstacle]:.6g}',
                             configuration=m, robots=[robot], obstacle=obstacle)
-    return configurations
+    return checked

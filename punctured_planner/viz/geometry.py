@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class PlaneView:
     """Orthogonal projection onto origin + span(u, v); labels name the two axes."""
 

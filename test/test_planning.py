@@ -1,0 +1,168 @@
+"""One request against one snapshot (planning.PlanSequenceHandler), without DDS."""
+
+import numpy as np
+from planner_helpers import make_request
+from planner_helpers import OBSTACLES
+from punctured_planner import conversions
+from punctured_planner.parameters import settings_from_values
+from punctured_planner.planning import ObstacleSet
+from punctured_planner.planning import PlanSequenceHandler
+from punctured_planner.planning import Snapshot
+
+
+def snapshot(**values):
+    settings = settings_from_values(values)
+    return Snapshot(settings, ObstacleSet(conversions.obstacles_from_parameter(
+        settings.obstacles)))
+
+
+def test_planner_caches_one_workspace_per_obstacle_set():
+    from punctured_planner_interfaces.srv import PlanSequence
+    planner = PlanSequenceHandler()
+    base = snapshot(obstacles=[v for o in OBSTACLES for v in o])
+    first = planner.workspace(base.settings, np.array(OBSTACLES)[:, :2])
+    assert planner.workspace(base.settings, np.array(OBSTACLES)[:, :2]) is first
+    paper = settings_from_values({'variant': 'paper'})
+    assert planner.workspace(paper, np.array(OBSTACLES)[:, :2]) is not first
+    outcome = planner.handle(make_request(), PlanSequence.Response(), base, 0)
+    assert outcome.ok and outcome.names == ['robot_0', 'robot_1', 'robot_2', 'robot_3']
+    assert outcome.start_ns > 0
+    again = planner.handle(make_request(), PlanSequence.Response(), base, 0)
+    assert again.plan.workspace is first
+
+
+def test_over_limit_requests_are_refused_before_conversion(monkeypatch):
+    """REQUEST_OVER_LIMITS from list lengths: no pose is converted, whatever the values."""
+    from geometry_msgs.msg import Pose
+    from geometry_msgs.msg import PoseArray
+    from punctured_planner_interfaces.srv import PlanSequence
+    request = PlanSequence.Request()
+    huge = PoseArray()
+    huge.poses = [Pose()] * 20001  # one shared Pose: cheap to build
+    request.configurations = [huge, huge]
+    converted = []
+    monkeypatch.setattr(conversions, 'pose_array_positions', converted.append)
+    outcome = PlanSequenceHandler().handle(request, PlanSequence.Response(), snapshot(), 0)
+    assert outcome.response.error_code == PlanSequence.Response.REQUEST_OVER_LIMITS
+    assert 'max_robots 10000' in outcome.response.error_msg
+    assert converted == []
+
+
+def test_array_holding_dataclasses_compare_by_identity():
+    """Frame, ObstacleSet, RobotState, PlaneView: == and hash work (no numpy ValueError)."""
+    from punctured_planner.core import Workspace
+    from punctured_planner.planning import RobotState
+    from punctured_planner.viz.geometry import PlaneView
+    frame = Workspace(np.array(OBSTACLES)[:, :2]).frame
+    items = [frame, ObstacleSet(np.zeros((2, 3))), RobotState(np.zeros((2, 3)), np.zeros((2, 4))),
+             PlaneView(np.zeros(2), np.eye(2)[0], np.eye(2)[1], ('x', 'y'))]
+    for item in items:
+        twin = type(item)(*(getattr(item, name) for name in item.__dataclass_fields__))
+        assert item == item and not item == twin and len({item, twin}) == 2
+
+
+def state_snapshot(positions, received_ns, **values):
+    """Return a snapshot with the example obstacles and a robot state received then."""
+    from punctured_planner.planning import RobotState
+    settings = settings_from_values({'obstacles': [v for o in OBSTACLES for v in o],
+                                     **values})
+    state = RobotState(np.asarray(positions, dtype=float), np.zeros((len(positions), 4)),
+                       'map', received_ns - 7, 'robot_states', received_ns)
+    return Snapshot(settings, ObstacleSet(np.array(OBSTACLES)), state)
+
+
+def answer(request, snapshot, now_ns):
+    from punctured_planner_interfaces.srv import PlanSequence
+    return PlanSequenceHandler().handle(request, PlanSequence.Response(), snapshot, now_ns)
+
+
+def test_a_stale_robot_state_is_refused_with_its_age_and_source():
+    """Issue 15.3: 5 s without robot_states is NO_ROBOT_STATE, not a plan from the past."""
+    from planner_helpers import CONFIGURATIONS
+    now = 1700000000 * 10 ** 9
+    request = make_request(CONFIGURATIONS[1:], use_current_state=True)
+    outcome = answer(request, state_snapshot(CONFIGURATIONS[0], now - 5 * 10 ** 9), now)
+    assert outcome.response.error_code == 2, outcome.response.error_msg
+    message = outcome.response.error_msg
+    assert 'robot_states' in message and '5.000 s old' in message
+    assert 'max_state_age 0.5' in message
+    fresh = answer(request, state_snapshot(CONFIGURATIONS[0], now - 10 ** 8), now)
+    assert fresh.ok, fresh.response.error_msg
+    unchecked = answer(request, state_snapshot(CONFIGURATIONS[0], now - 5 * 10 ** 9,
+                                               max_state_age=0.0), now)
+    assert unchecked.ok
+
+
+def test_a_configuration_repeating_the_current_state_is_dropped():
+    """Issue 15.2: resending the current positions first is no 30 s detour."""
+    from planner_helpers import CONFIGURATIONS
+    now = 10 ** 18
+    state = np.array(CONFIGURATIONS[0])
+    again = state + [[1e-4, 0.0, 0.0]] * 4  # within repeat_tolerance 1e-3
+    resent = answer(make_request([again] + CONFIGURATIONS[1:], use_current_state=True),
+                    state_snapshot(state, now), now)
+    direct = answer(make_request(CONFIGURATIONS[1:], use_current_state=True),
+                    state_snapshot(state, now), now)
+    assert resent.ok and direct.ok, resent.response.error_msg
+    assert list(resent.response.dropped_configurations) == [0]
+    assert list(direct.response.dropped_configurations) == []
+    assert resent.plan.duration(1.0) == direct.plan.duration(1.0)
+    assert list(resent.response.projection_counts) == list(direct.response.projection_counts)
+    assert len(resent.response.waypoint_indices) == 3
+    only = answer(make_request([again], use_current_state=True), state_snapshot(state, now),
+                  now)
+    assert only.response.error_code == 1
+    assert 'already there' in only.response.error_msg
+    # Beyond the tolerance the configuration is planned, as before.
+    moved = answer(make_request([state + [[0.01, 0.0, 0.0]] * 4], use_current_state=True),
+                   state_snapshot(state, now), now)
+    assert moved.ok and list(moved.response.dropped_configurations) == []
+
+
+def test_messages_name_the_culprit_the_one_way():
+    """Issue 15.5: the count mismatch blames the state and says robot_count; obstacles named."""
+    from planner_helpers import CONFIGURATIONS
+    now = 10 ** 18
+    request = make_request([c[:3] for c in CONFIGURATIONS[1:]], use_current_state=True)
+    outcome = answer(request, state_snapshot(CONFIGURATIONS[0], now, robot_count=3), now)
+    assert outcome.response.error_code == 5
+    assert outcome.response.error_msg == (
+        'configuration 0 (the current robot state from robot_states) has 4 robots but the '
+        'node is configured for robot_count 3')
+    on_obstacle = [list(p) for p in CONFIGURATIONS[1]]
+    on_obstacle[2] = OBSTACLES[1]
+    outcome = answer(make_request([CONFIGURATIONS[0], on_obstacle], use_current_state=True),
+                     state_snapshot(CONFIGURATIONS[0], now), now)
+    assert outcome.response.error_code == 11
+    # configurations[0] repeats the state and is dropped: numbering stays the request's.
+    assert outcome.response.error_msg == (
+        'configuration 2 (request configurations[1]): robot 2 is on obstacle 1 at '
+        '(0, -0.5, 0) (from the parameter)')
+
+
+def test_log_stamps_keep_every_nanosecond():
+    """Issue 15.6: ...870.584161458 was logged as ...870.584161758 through a float."""
+    from punctured_planner.planning import RobotState
+    stamp = 1700000870584161458
+    assert '1700000870.584161458' in ObstacleSet(np.zeros((1, 3)), 'map', '/obstacles',
+                                                 stamp).describe()
+    assert '1700000870.584161458' in RobotState(np.zeros((1, 3)), np.zeros((1, 4)), 'map',
+                                                stamp).describe()
+
+
+def test_bundled_scenario_refuses_a_goal_grazing_an_obstacle():
+    """Issue 15.7: the bundled scenario requires clearance; 1 um from an obstacle is refused."""
+    import os
+    from conftest import REPO_ROOT
+    from planner_helpers import CONFIGURATIONS
+    from punctured_planner.parameters import load_parameter_file
+    values = load_parameter_file(os.path.join(REPO_ROOT, 'config', 'default_scenario.yaml'))
+    settings = settings_from_values(values)
+    assert settings.required_clearance > 0
+    snapshot = Snapshot(settings, ObstacleSet(conversions.obstacles_from_parameter(
+        settings.obstacles)))
+    goal = [list(p) for p in CONFIGURATIONS[2]]
+    goal[0] = [OBSTACLES[2][0] + 1e-6, OBSTACLES[2][1], 0.0]
+    outcome = answer(make_request([CONFIGURATIONS[0], goal]), snapshot, 0)
+    assert outcome.response.error_code == 12, outcome.response.error_msg
+    assert answer(make_request(), snapshot, 0).ok
