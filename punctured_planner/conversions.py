@@ -196,6 +196,7 @@ def fill_response(response, plan, paths, planning_time, max_speed, waypoints, dr
     response.optimal = bool(plan.optimal)
     response.projection_counts = [int(c) for c in np.asarray(plan.projection_counts).tolist()]
     response.min_clearance = float(plan.min_clearance)
+    response.min_gap = float(plan.min_gap)
     response.planning_time = duration_from_seconds(planning_time)
     response.duration = duration_from_seconds(plan.duration(max_speed))
     response.paths = paths
@@ -204,18 +205,20 @@ def fill_response(response, plan, paths, planning_time, max_speed, waypoints, dr
     return response
 
 
-def fill_error(response, code, message, planning_time=0.0, min_clearance=None):
+def fill_error(response, code, message, planning_time=0.0, clearance=None, gap=None):
     """
     Fill a PlanSequence response for a refused request (no plan, no paths).
 
-    Every plan field is reset, so a failure after a partial fill leaves nothing behind.
+    Every plan field is reset, so a failure after a partial fill leaves nothing
+    behind; a refused plan's certificates (clearance, gap) still report what it had.
     """
     response.error_code = int(code)
     response.error_msg = str(message)
     response.domain_index = response.domain_count = response.sequential_complexity = 0
     response.optimal = False
     response.projection_counts = []
-    response.min_clearance = float(min_clearance) if min_clearance is not None else 0.0
+    response.min_clearance = float(clearance.distance) if clearance is not None else 0.0
+    response.min_gap = float(gap.distance) if gap is not None else 0.0
     response.planning_time = duration_from_seconds(planning_time)
     response.duration = Duration()
     response.paths = []

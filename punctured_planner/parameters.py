@@ -17,6 +17,9 @@ import yaml
 
 from .core import VARIANTS
 
+# The variant parameter's default: 'discs' with a robot radius, else 'spread'.
+AUTO = 'auto'
+
 NODE_NAME = 'planner_node'
 # Largest samples_per_leg a parameter or a request may ask for.
 MAX_SAMPLES_PER_LEG = 1000
@@ -58,10 +61,20 @@ PARAMETERS = (
          'Obstacles as a flat list x0, y0, z0, x1, y1, z1, ...; the latest of this '
          "parameter and the 'obstacles' topic is the obstacle set.",
          constraints='length a multiple of 3, finite values'),
-    Spec('variant', 'string', 'spread',
-         "Planner variant: 'spread' (clearance-aware spreading leg) or 'paper' (the "
-         "paper's construction exactly); both give the same domain index.",
-         constraints="'spread' or 'paper'"),
+    Spec('variant', 'string', AUTO,
+         "Planner variant: 'discs' (disc robots and pillars: bodies never touch under "
+         "the separation condition of doc/design.md section 7), 'spread' (clearance-aware "
+         "spreading leg) or 'paper' (the paper's construction exactly); all give the "
+         "same domain index. 'auto': 'discs' when robot_radius > 0, else 'spread'.",
+         constraints="'auto', 'discs', 'spread' or 'paper'"),
+    Spec('robot_radius', 'double', 0.0,
+         'Radius R of every robot (m): robots are discs (balls for dimension 3); then '
+         'overlapping bodies are refused, min_gap is the surface gap and '
+         'required_clearance applies to it.', low=0.0, high=1e6),
+    Spec('obstacle_radius', 'double_array', [],
+         'Radius of the obstacles (m): empty for 0, one value for all, or one per '
+         'obstacle in obstacle order (then the obstacle set must have that many).',
+         constraints='empty, one value or one per obstacle; finite, >= 0'),
     Spec('lane_spacing', 'double', 1.0,
          'Spacing of the lanes the robots slide along (m); 1 gives the paper heights.',
          low=1e-6, high=1e6),
@@ -109,7 +122,9 @@ class Settings:
     robot_names: tuple = ()
     robot_count: int = 0
     obstacles: tuple = ()
-    variant: str = 'spread'
+    variant: str = AUTO
+    robot_radius: float = 0.0
+    obstacle_radius: tuple = ()
     lane_spacing: float = 1.0
     min_spacing: float = 0.5
     required_clearance: float = 0.0
@@ -120,6 +135,19 @@ class Settings:
     max_robots: int = 10000
     max_configurations: int = 1000
     max_poses: int = 2000000
+
+    @property
+    def core_variant(self) -> str:
+        """Return the core variant to plan with: 'auto' resolved by robot_radius."""
+        if self.variant != AUTO:
+            return self.variant
+        return 'discs' if self.robot_radius > 0 else 'spread'
+
+    def obstacle_radii(self, obstacle_count: int) -> float | tuple:
+        """Return the core's obstacle_radius for r obstacles: a scalar, or one per obstacle."""
+        if len(self.obstacle_radius) <= 1:
+            return self.obstacle_radius[0] if self.obstacle_radius else 0.0
+        return self.obstacle_radius
 
     @property
     def expected_robot_count(self):
@@ -174,8 +202,11 @@ def _check_value(spec, value):
                          % (spec.name, spec.low, spec.high, value))
     if spec.name == 'frame_id' and not value:
         raise ValueError('frame_id must not be empty')
-    if spec.name == 'variant' and value not in VARIANTS:
-        raise ValueError('variant must be one of %s, got %r' % (', '.join(VARIANTS), value))
+    if spec.name == 'variant' and value not in (AUTO,) + VARIANTS:
+        raise ValueError('variant must be one of %s, got %r'
+                         % (', '.join((AUTO,) + VARIANTS), value))
+    if spec.name == 'obstacle_radius' and any(radius < 0 for radius in value):
+        raise ValueError('obstacle_radius values must be >= 0, got %r' % (list(value),))
     if spec.name == 'obstacles' and len(value) % 3:
         raise ValueError('obstacles must hold x, y, z per obstacle: %d values is not a '
                          'multiple of 3' % len(value))

@@ -121,9 +121,9 @@ class PlannerNode(Node):
                                             self._on_plan_sequence)
         s = self._settings
         self.get_logger().info(
-            'serving %s: frame %s, dimension %d, variant %s, %s, robots %s'
-            % (self.resolve_service_name('plan_sequence'), s.frame_id, s.dimension, s.variant,
-               self._obstacles.describe(),
+            'serving %s: frame %s, dimension %d, variant %s, robot radius %g, %s, robots %s'
+            % (self.resolve_service_name('plan_sequence'), s.frame_id, s.dimension,
+               s.core_variant, s.robot_radius, self._obstacles.describe(),
                ', '.join(s.robot_names) or (str(s.robot_count) if s.robot_count else 'any')))
 
     # ------------------------------------------------------------ parameters

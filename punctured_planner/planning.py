@@ -196,17 +196,20 @@ class PlanSequenceHandler:
         give the same Workspace object (and the same domains). Raises PlanningError.
         """
         obstacles = np.ascontiguousarray(obstacles, dtype=float)
-        key = (obstacles.shape, obstacles.tobytes(), settings.dimension, settings.variant,
-               settings.lane_spacing, settings.min_spacing, settings.required_clearance)
+        key = (obstacles.shape, obstacles.tobytes(), settings.dimension, settings.core_variant,
+               settings.lane_spacing, settings.min_spacing, settings.required_clearance,
+               settings.robot_radius, settings.obstacle_radius)
         with self._lock:
             found = self._cache.get(key)
             if found is not None:
                 self._cache.move_to_end(key)
                 return found
         workspace = Workspace(obstacles, dimension=settings.dimension,
-                              lane_spacing=settings.lane_spacing, variant=settings.variant,
-                              min_spacing=settings.min_spacing,
-                              required_clearance=settings.required_clearance)
+                              lane_spacing=settings.lane_spacing,
+                              variant=settings.core_variant, min_spacing=settings.min_spacing,
+                              required_clearance=settings.required_clearance,
+                              robot_radius=settings.robot_radius,
+                              obstacle_radius=settings.obstacle_radii(len(obstacles)))
         with self._lock:
             self._cache[key] = workspace
             while len(self._cache) > self._cache_size:
@@ -231,10 +234,9 @@ class PlanSequenceHandler:
             return self._answer(response, gathered, checked, the_plan, snapshot.settings,
                                 now_ns, started)
         except PlanningError as error:
-            minimum = error.clearance.distance if error.clearance is not None else None
             message = self._message(error, gathered, checked, snapshot.obstacles)
             conversions.fill_error(response, error.code, message,
-                                   time.perf_counter() - started, minimum)
+                                   time.perf_counter() - started, error.clearance, error.gap)
             return Outcome(response=response)
         except Exception as error:  # any bug becomes UNKNOWN, the node serves on
             conversions.fill_error(response, ErrorCode.UNKNOWN,
@@ -373,7 +375,7 @@ class PlanSequenceHandler:
         if samples > MAX_SAMPLES_PER_LEG:
             _fail(ErrorCode.REQUEST_OVER_LIMITS, 'samples_per_leg %d is more than %d'
                   % (samples, MAX_SAMPLES_PER_LEG))
-        schedule = SCHEDULES.get(settings.variant)
+        schedule = SCHEDULES.get(settings.core_variant)
         if schedule is None:
             return  # no fixed legs ('discs'): its breakpoints are known only once planned
         poses = k * ((schedule.breakpoint_count(n) - 1) * (samples + 1) + 1)

@@ -19,6 +19,8 @@ from .conversions import robot_names
 from .conversions import time_from_ns
 from .conversions import to_xyz
 
+# Height (m) of the cylinder drawn for a pillar with a radius.
+PILLAR_HEIGHT = 1.0
 # Colours of the robots in the markers (RGB, matplotlib's tab10).
 PALETTE = (
     (0.122, 0.467, 0.706), (1.000, 0.498, 0.055), (0.173, 0.627, 0.173),
@@ -50,7 +52,9 @@ def plan_markers(plan, frame_id, stamp_ns, plane_z=0.0, names=None, max_speed=1.
     spheres), ``axis`` (the e1 axis, grey), ``lanes`` (one thin line per
     robot lane, a LINE_LIST), ``paths`` (one LINE_STRIP per robot through
     every breakpoint, none twice, robot colours), ``waypoints`` (one SPHERE_LIST per
-    configuration C_m) and ``labels`` (robot names at C_1).
+    configuration C_m) and ``labels`` (robot names at C_1); with radii also
+    ``pillars`` (one cylinder of its diameter per obstacle) and ``bodies`` (the
+    robots' discs at each C_m, translucent, of diameter 2 robot_radius).
     """
     header = Header(frame_id=frame_id, stamp=time_from_ns(stamp_ns))
     positions = to_xyz(plan.positions, plane_z)
@@ -71,6 +75,14 @@ def plan_markers(plan, frame_id, stamp_ns, plane_z=0.0, names=None, max_speed=1.
     if len(obstacles):
         markers.append(marker('obstacles', 0, Marker.SPHERE_LIST,
                               ColorRGBA(r=0.0, g=0.0, b=0.0, a=1.0), 0.25 * scale, obstacles))
+    for j, radius in enumerate(plan.workspace.obstacle_radii.tolist()):
+        if radius > 0:  # the pillar's body: a cylinder of its diameter
+            pillar = marker('pillars', j, Marker.CYLINDER,
+                            ColorRGBA(r=0.3, g=0.3, b=0.3, a=0.6), 2 * radius)
+            pillar.scale.z = PILLAR_HEIGHT
+            pillar.pose.position.x, pillar.pose.position.y = obstacles[j, :2].tolist()
+            pillar.pose.position.z = float(obstacles[j, 2]) + 0.5 * PILLAR_HEIGHT
+            markers.append(pillar)
     axis = to_xyz(plan.axis_segment(), plane_z)
     markers.append(marker('axis', 0, Marker.LINE_STRIP,
                           ColorRGBA(r=0.5, g=0.5, b=0.5, a=0.8), width, axis))
@@ -81,11 +93,17 @@ def plan_markers(plan, frame_id, stamp_ns, plane_z=0.0, names=None, max_speed=1.
     for i in range(k):
         markers.append(marker('paths', i, Marker.LINE_STRIP, _colour(i), width,
                               moving[:, i]))
+    radius = plan.workspace.robot_radius
     for m, index in enumerate(np.asarray(plan.waypoint_indices).tolist()):
         item = marker('waypoints', m, Marker.SPHERE_LIST,
                       ColorRGBA(r=1.0, g=1.0, b=1.0, a=1.0), 0.2 * scale, positions[index])
         item.colors = [_colour(i) for i in range(k)]
         markers.append(item)
+        if radius > 0:  # the robots' bodies at C_m: discs of their diameter
+            bodies = marker('bodies', m, Marker.SPHERE_LIST, ColorRGBA(), 2 * radius,
+                            positions[index])
+            bodies.colors = [_colour(i, 0.35) for i in range(k)]
+            markers.append(bodies)
     for i in range(k):
         label = marker('labels', i, Marker.TEXT_VIEW_FACING,
                        ColorRGBA(r=0.0, g=0.0, b=0.0, a=1.0), 0.3 * scale)

@@ -138,6 +138,19 @@ def path_array(path):
     return path_positions(path), path_stamps_ns(path)
 
 
+def scenario_plan(configurations=CONFIGURATIONS):
+    """Return the core's plan with the bundled scenario's parameters (its radii, variant)."""
+    from conftest import REPO_ROOT
+    from punctured_planner.parameters import load_parameter_file, settings_from_values
+    settings = settings_from_values(load_parameter_file(
+        os.path.join(REPO_ROOT, 'config', 'default_scenario.yaml')))
+    return core_plan(configurations, variant=settings.core_variant,
+                     lane_spacing=settings.lane_spacing, min_spacing=settings.min_spacing,
+                     required_clearance=settings.required_clearance,
+                     robot_radius=settings.robot_radius,
+                     obstacle_radius=settings.obstacle_radii(len(OBSTACLES)))
+
+
 def core_plan(configurations=CONFIGURATIONS, obstacles=OBSTACLES, dimension=2, **options):
     """Return the core's plan for the same input the node gets (spread by default)."""
     from punctured_planner.core import plan

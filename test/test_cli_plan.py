@@ -10,7 +10,7 @@ import subprocess
 from conftest import REPO_ROOT
 from conftest import venv_script
 import numpy as np
-from planner_helpers import core_plan
+from planner_helpers import scenario_plan
 from punctured_planner.cli import main
 import pytest
 import yaml
@@ -29,7 +29,7 @@ def run(capsys, *argv):
 def test_plan_prints_the_same_answer_as_the_node(capsys):
     code, data, err = run(capsys, 'plan', EXAMPLE, '--params', SCENARIO)
     assert code == 0, err
-    expected = core_plan()
+    expected = scenario_plan()
     assert data['error_code'] == 0 and data['error_msg'] == ''
     assert data['domain_index'] == expected.domain_index
     assert data['projection_counts'] == expected.projection_counts.tolist()
@@ -67,7 +67,7 @@ def test_plan_png_and_mcap_from_the_console_script(tmp_path, ros_env):
         env=ros_env, capture_output=True, text=True, timeout=120)
     assert result.returncode == 0, result.stderr
     assert png.read_bytes()[:8] == b'\x89PNG\r\n\x1a\n' and png.stat().st_size > 10000
-    check_recording(mcap, core_plan())
+    check_recording(mcap, scenario_plan())
 
 
 def check_recording(path, expected):

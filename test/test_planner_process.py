@@ -11,7 +11,7 @@ import subprocess
 from conftest import REPO_ROOT
 from conftest import venv_script
 import numpy as np
-from planner_helpers import core_plan
+from planner_helpers import scenario_plan
 from planner_helpers import Latest
 from planner_helpers import path_array
 import pytest
@@ -42,7 +42,7 @@ def test_default_scenario_across_processes(planner_process, ros_client, ros_env)
 
     response = ros_client.call(client, example_request())
     assert response.error_code == PlanSequence.Response.NONE, response.error_msg + node.log()
-    expected = core_plan()
+    expected = scenario_plan()
     assert response.domain_index == expected.domain_index
     assert len(response.paths) == 4
     for i, path in enumerate(response.paths):

@@ -151,7 +151,13 @@ def test_log_stamps_keep_every_nanosecond():
 
 
 def test_bundled_scenario_refuses_a_goal_grazing_an_obstacle():
-    """Issue 15.7: the bundled scenario requires clearance; 1 um from an obstacle is refused."""
+    """
+    Issue 15.7: the bundled scenario has bodies and a required gap.
+
+    A goal 1 um from an obstacle's centre puts the robot's disc on the pillar
+    (ROBOT_ON_OBSTACLE); one whose disc touches the pillar's is planned but
+    refused for the gap (CLEARANCE_BELOW_REQUIRED).
+    """
     import os
     from conftest import REPO_ROOT
     from planner_helpers import CONFIGURATIONS
@@ -161,8 +167,15 @@ def test_bundled_scenario_refuses_a_goal_grazing_an_obstacle():
     assert settings.required_clearance > 0
     snapshot = Snapshot(settings, ObstacleSet(conversions.obstacles_from_parameter(
         settings.obstacles)))
+    assert settings.robot_radius > 0 and settings.core_variant == 'discs'
     goal = [list(p) for p in CONFIGURATIONS[2]]
     goal[0] = [OBSTACLES[2][0] + 1e-6, OBSTACLES[2][1], 0.0]
     outcome = answer(make_request([CONFIGURATIONS[0], goal]), snapshot, 0)
+    assert outcome.response.error_code == 11, outcome.response.error_msg
+    assert 'overlaps obstacle 2' in outcome.response.error_msg
+    touching = settings.robot_radius + settings.obstacle_radius[0]
+    goal[0] = [OBSTACLES[2][0], OBSTACLES[2][1] - touching, 0.0]
+    outcome = answer(make_request([CONFIGURATIONS[0], goal]), snapshot, 0)
     assert outcome.response.error_code == 12, outcome.response.error_msg
+    assert outcome.response.min_gap < settings.required_clearance
     assert answer(make_request(), snapshot, 0).ok

@@ -39,15 +39,17 @@ class PlanningError(ValueError):
 
     def __init__(self, code: int, message: str, configuration: int | None = None,
                  robots: Iterable[int] = (), obstacle: int | None = None,
-                 clearance: Any = None) -> None:
+                 clearance: Any = None, gap: Any = None) -> None:
         """Store the code and the culprit; the message is the human-readable reason."""
         super().__init__(message)
         self.code = ErrorCode(code)
         self.configuration = configuration
         self.robots = tuple(int(i) for i in robots)
         self.obstacle = obstacle
-        # The refused plan's Clearance certificate (CLEARANCE_BELOW_REQUIRED only).
+        # The refused plan's Clearance certificates, centre distance and surface gap
+        # (CLEARANCE_BELOW_REQUIRED only; gap None where rounding left it untrusted).
         self.clearance = clearance
+        self.gap = gap
 
     def __str__(self) -> str:
         """Return the message prefixed by the code name."""

@@ -291,4 +291,5 @@ def _check_required_clearance(result):
         f'{certificate.leg} ({result.leg_names[certificate.leg]} of segment C_{segment + 1} -> '
         f'C_{segment + 2}) at tau {certificate.tau:.6g}',
         configuration=segment, robots=[a] if certificate.kind == 'obstacle' else [a, b],
-        obstacle=b if certificate.kind == 'obstacle' else None, clearance=certificate)
+        obstacle=b if certificate.kind == 'obstacle' else None, clearance=result.clearance,
+        gap=result.gap if trusted else None)

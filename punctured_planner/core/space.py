@@ -228,9 +228,17 @@ class Workspace:
 
     @cached_property
     def disc_layout(self) -> DiscLayout:
-        """Return the pillars, reaches and pitches of the 'discs' construction."""
-        return DiscLayout.from_radii(self.frame, self.obstacles, self.robot_radius,
-                                     self.obstacle_radii, self.lane_spacing, self.min_spacing)
+        """
+        Return the pillars, reaches and pitches of the 'discs' construction.
+
+        With bodies, a required gap c is planned for by inflating every body by
+        c / 2: a gap >= 0 between the inflated bodies is a gap >= c between the real ones.
+        """
+        inflation = 0.5 * self.required_clearance if self.has_bodies else 0.0
+        return DiscLayout.from_radii(self.frame, self.obstacles,
+                                     self.robot_radius + inflation,
+                                     self.obstacle_radii + inflation, self.lane_spacing,
+                                     self.min_spacing)
 
 
 def _checked_radii(robot_radius, obstacle_radius, obstacle_count):

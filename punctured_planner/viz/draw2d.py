@@ -2,11 +2,12 @@
 Draw a plan on 2-D axes through a PlaneView: the static picture and the animation background.
 
 Layers, bottom to top: e1 axis, dashed lanes, robot paths with direction
-arrows, obstacles, numbered waypoints C_1..C_n, the certified closest approach.
+arrows, obstacles (and their discs), numbered waypoints C_1..C_n (and the
+robots' discs there), the certified closest approach (smallest gap with radii).
 """
 
 from matplotlib.lines import Line2D
-from matplotlib.patches import FancyArrowPatch
+from matplotlib.patches import Circle, FancyArrowPatch
 import numpy as np
 
 from .geometry import closest_approach, extent, moving_legs, waypoints
@@ -42,15 +43,22 @@ def draw_paths(ax, plan, view, colours, alpha=1.0, arrows=True):
 
 
 def draw_obstacles(ax, plan, view, size=70):
-    """Draw the obstacles as black crosses."""
+    """Draw the obstacles as black crosses, and their discs where they have a radius."""
     obstacles = view(plan.workspace.obstacles)
     ax.scatter(obstacles[:, 0], obstacles[:, 1], marker='X', s=size, color='black', zorder=4)
+    for (x, y), radius in zip(obstacles, plan.workspace.obstacle_radii):
+        if radius > 0:
+            ax.add_patch(Circle((x, y), radius, fc='0.25', ec='black', alpha=0.5, zorder=3))
 
 
 def draw_waypoints(ax, plan, view, colours, size=12):
-    """Draw C_1..C_n as circles in each robot's colour, numbered 1..n."""
+    """Draw C_1..C_n as circles in each robot's colour, numbered 1..n, and the robots' discs."""
+    radius = plan.workspace.robot_radius
     for m, configuration in enumerate(view(waypoints(plan))):
         for (x, y), colour in zip(configuration, colours):
+            if radius > 0:
+                ax.add_patch(Circle((x, y), radius, fc=colour, ec=colour, alpha=0.25,
+                                    zorder=4))
             ax.plot(x, y, 'o', ms=size, mfc='white', mec=colour, mew=1.6, zorder=5)
             ax.text(x, y, str(m + 1), ha='center', va='center', fontsize=0.6 * size,
                     color=colour, fontweight='bold', zorder=6)
@@ -79,8 +87,9 @@ def legend_handles(plan, colours, waypoints_numbered=True):
         handles.append(Line2D([], [], ls='none', marker='o', ms=9, mfc='white', mec='0.3',
                               label='C_m (numbered m)'))
     if closest_approach(plan) is not None:
-        handles.append(Line2D([], [], ls=':', color=CLEARANCE_COLOUR, lw=1.6,
-                              label=f'closest: {plan.min_clearance:.3g}'))
+        label = (f'smallest gap: {plan.min_gap:.3g}' if plan.workspace.has_bodies
+                 else f'closest: {plan.min_clearance:.3g}')
+        handles.append(Line2D([], [], ls=':', color=CLEARANCE_COLOUR, lw=1.6, label=label))
     return handles
 
 

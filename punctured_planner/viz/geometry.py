@@ -49,8 +49,12 @@ def moving_legs(points, minimum_length):
 
 
 def closest_approach(plan):
-    """Return the (2, d) points of the certified closest approach, or None if there is none."""
-    clearance = plan.clearance
+    """
+    Return the (2, d) centres of the certified closest approach, or None if there is none.
+
+    With robot or obstacle radii, the pair with the smallest surface gap.
+    """
+    clearance = plan.gap if plan.workspace.has_bodies else plan.clearance
     if clearance.kind == 'none' or not np.isfinite(clearance.distance):
         return None
     positions = plan.position(clearance.tau)

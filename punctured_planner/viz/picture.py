@@ -12,13 +12,19 @@ from .geometry import plane_view
 
 
 def clearance_text(plan):
-    """Return one line naming the certified clearance and where it is reached."""
-    clearance = plan.clearance
+    """
+    Return one line naming the certified clearance and where it is reached.
+
+    With robot or obstacle radii it is the surface gap (negative: the bodies touch).
+    """
+    bodies = plan.workspace.has_bodies
+    clearance = plan.gap if bodies else plan.clearance
+    what = 'gap' if bodies else 'clearance'
     if clearance.kind == 'none':
-        return 'certified clearance: nothing to collide with'
+        return f'certified {what}: nothing to collide with'
     a, b = clearance.indices
     who = f'robots {a}, {b}' if clearance.kind == 'robots' else f'robot {a}, obstacle {b}'
-    return (f'certified clearance {clearance.distance:.4g} ({who}; '
+    return (f'certified {what} {clearance.distance:.4g} ({who}; '
             f'{plan.leg_names[clearance.leg]} leg, tau {clearance.tau:.3f})')
 
 
