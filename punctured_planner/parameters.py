@@ -63,7 +63,7 @@ PARAMETERS = (
          constraints='length a multiple of 3, finite values'),
     Spec('variant', 'string', AUTO,
          "Planner variant: 'discs' (disc robots and pillars: bodies never touch under "
-         "the separation condition of doc/design.md section 7), 'spread' (clearance-aware "
+         "the separation condition of doc/design.md section 6), 'spread' (clearance-aware "
          "spreading leg) or 'paper' (the paper's construction exactly); all give the "
          "same domain index. 'auto': 'discs' when robot_radius > 0, else 'spread'.",
          constraints="'auto', 'discs', 'spread' or 'paper'"),

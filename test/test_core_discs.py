@@ -1,7 +1,7 @@
 """
 The 'discs' variant: bodies never touch under the stated condition, and the paper's domains.
 
-The condition (punctured_planner/core/discs.py, doc/design.md section 7):
+The condition (punctured_planner/core/discs.py, doc/design.md section 6):
 robot centres at least S = max(4R, 2R + max w_j) apart, no disc overlapping a
 pillar, and pillar pairs meeting condition (c). The strategies build inputs
 that meet exactly that, adversarially: robots on a lattice of pitch exactly

@@ -1,5 +1,5 @@
 """
-Disc robots among pillars: the variant 'discs' (doc/design.md section 7).
+Disc robots among pillars: the variant 'discs' (doc/design.md section 6).
 
 Robots are discs (balls for d >= 3) of radius R, obstacle j a pillar of radius
 rho_j; the surface gap of two robots is |x_a - x_b| - 2R, of a robot and a
@@ -8,6 +8,10 @@ offset and w_j = R + rho_j + mu_j for the reach of pillar j, where the passing
 margin mu_j = clip(R - rho_j, 0, R / 10) keeps robots off the pillars
 they pass without w_j exceeding 2R when rho_j <= R (w_j = min_spacing / 2 when
 both radii are 0, so point robots still keep off point obstacles).
+
+A required gap c (required_clearance) is planned for by inflating R and every
+rho_j by c / 2 (Workspace.disc_layout): a gap >= 0 between the inflated bodies
+is a gap >= c between the real ones.
 
 The construction keeps the paper's skeleton, H(C_m), Gamma, H(C_{m+1})^-1
 (Remark 2.3), with a new deformation H onto a new kind of base configuration:

@@ -126,7 +126,7 @@ class Workspace:
 
     ``variant`` is 'paper' (the paper's construction, exact), 'spread' (adds
     the spreading leg S and lanes `lane_spacing` apart beyond the obstacles) or
-    'discs' (robots and obstacles with radii; doc/design.md section 7).
+    'discs' (robots and obstacles with radii; doc/design.md section 6).
     ``robot_radius`` R and ``obstacle_radius`` rho (a scalar, or one per
     obstacle) make robots and obstacles discs (balls for d >= 3); then a
     configuration whose bodies overlap is refused.
