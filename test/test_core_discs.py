@@ -149,8 +149,13 @@ def test_gap_is_distance_minus_radii_and_required_clearance_applies_to_it():
     assert p.min_gap <= min(robots, obstacle) + 1e-12
     assert p.min_gap >= min(robots, obstacle) - 1e-3
     assert point_plan.min_gap == point_plan.min_clearance
+    # A required gap is planned for (bodies inflated by half of it) and met...
+    wider = Workspace(pillars, variant='discs', robot_radius=0.2, obstacle_radius=0.1,
+                      required_clearance=p.min_gap + 0.3)
+    assert plan(wider, configurations).min_gap >= p.min_gap + 0.3
+    # ... unless the configurations themselves are closer: robots 0, 1 of C_1 are 3.6 apart.
     strict = Workspace(pillars, variant='discs', robot_radius=0.2, obstacle_radius=0.1,
-                       required_clearance=p.min_gap + 0.01)
+                       required_clearance=3.7)
     with pytest.raises(PlanningError) as caught:
         plan(strict, configurations)
     assert caught.value.code == ErrorCode.CLEARANCE_BELOW_REQUIRED

@@ -258,10 +258,10 @@ def shared_lanes(first: np.ndarray, second: np.ndarray) -> np.ndarray:
     reverses. It depends on the two rank orders only.
     """
     lanes = np.empty(len(first), dtype=int)
-    tops = []  # last second-slot of each lane; decreasing along the list
-    for robot in np.argsort(first):
-        target = second[robot]
-        lane = bisect_left([-top for top in tops], -target)
+    tops: list[int] = []  # minus the last second slot of each lane: increasing along the list
+    for robot in np.argsort(first).tolist():
+        target = -int(second[robot])
+        lane = bisect_left(tops, target)
         if lane == len(tops):
             tops.append(target)
         else:
@@ -295,24 +295,22 @@ def section(configurations: np.ndarray, layout: DiscLayout) -> DiscSection:
         names = [SIDESTEP] + [RISE] * (len(risen) - 2)
         rank = staging_ranks(configuration, layout)
         deformations.append((risen, names, rank, staging_slots(configuration, rank, layout)))
-    stages, names, waypoints, heights = [configurations[0]], [], [0], set()
+    stages, names, ends, heights = [configurations[0]], [''], [], set()
     for m in range(n - 1):
         risen, rise_names, rank, slots = deformations[m]
         back, back_names, next_rank, next_slots = deformations[m + 1]
         lift = (1.0 + shared_lanes(rank, next_rank)) * layout.lane_pitch
         heights.update((layout.top + lift).tolist())
-        segment = ([(stage, name) for stage, name in zip(risen[1:], rise_names)]
-                   + [(slots, GATHER), (slots + lift[:, None] * e2, LIFT),
-                      (next_slots + lift[:, None] * e2, SLIDE), (next_slots, DROP),
-                      (back[-1], GATHER + '^-1')]
-                   + [(stage, name + '^-1')
-                      for stage, name in zip(back[-2::-1], back_names[::-1])])
-        for stage, name in segment:
-            if np.array_equal(stage, stages[-1]):
-                continue
-            stages.append(stage)
-            names.append(name)
+        stages += [*risen[1:], slots, slots + lift[:, None] * e2,
+                   next_slots + lift[:, None] * e2, next_slots, back[-1], *back[-2::-1]]
+        names += [*rise_names, GATHER, LIFT, SLIDE, DROP, GATHER + '^-1',
+                  *(name + '^-1' for name in back_names[::-1])]
         stages[-1] = configurations[m + 1]
-        waypoints.append(len(stages) - 1)
-    return DiscSection(np.stack(stages), tuple(names), np.array(waypoints),
+        ends.append(len(stages) - 1)
+    every = np.stack(stages)
+    # A stage equal to the one before it (a leg in which no robot moves) is left out;
+    # a configuration left out that way is bit for bit the stage kept before it.
+    kept = np.concatenate([[True], np.any(every[1:] != every[:-1], axis=(1, 2))])
+    waypoints = np.concatenate([[0], np.cumsum(kept)[ends] - 1])
+    return DiscSection(every[kept], tuple(np.array(names)[kept][1:].tolist()), waypoints,
                        np.array(sorted(heights)))
