@@ -275,18 +275,20 @@ def summary(results, condition, ratios):
     return lines
 
 
+def report(settings):
+    """Run the benchmark; return its Markdown lines: the targets, then the table per k."""
+    start = time.perf_counter()
+    results, condition, ratios = run(settings, lambda label: print(
+        f'{time.perf_counter() - start:7.1f} s  {label}', file=sys.stderr, flush=True))
+    return summary(results, condition, ratios) + ['', format_table(share_rows(results))]
+
+
 def main(argv=None):
     """Run the benchmark and print its tables."""
     parser = argparse.ArgumentParser(description=__doc__.strip().splitlines()[0])
     parser.add_argument('--quick', action='store_true', help='a small grid (smoke run)')
     args = parser.parse_args(argv)
-    settings = quick_settings() if args.quick else Settings()
-    start = time.perf_counter()
-    results, condition, ratios = run(settings, lambda label: print(
-        f'{time.perf_counter() - start:7.1f} s  {label}', file=sys.stderr, flush=True))
-    print('\n'.join(summary(results, condition, ratios)))
-    print()
-    print(format_table(share_rows(results)))
+    print('\n'.join(report(quick_settings() if args.quick else Settings())))
 
 
 if __name__ == '__main__':

@@ -17,6 +17,7 @@ import time
 
 import core_speed
 from core_speed import format_table
+import discs
 import numpy as np
 import peers
 
@@ -122,7 +123,7 @@ def service_sweep(quick):
     return result.stdout.strip() or 'failed:\n' + result.stderr.strip()[-2000:]
 
 
-def write_markdown(figures, outcomes, settings, seconds, stages, profiles, service):
+def write_markdown(figures, outcomes, settings, seconds, stages, profiles, service, disc_lines):
     """Write bench/results.md."""
     by = {
         'k': lambda q: q.k, 'kind': lambda q: q.kind, 'd': lambda q: q.d,
@@ -157,6 +158,8 @@ def write_markdown(figures, outcomes, settings, seconds, stages, profiles, servi
     ]
     for name, text in profiles.items():
         parts += [f'cProfile, {name}:', '', '```', text, '```', '']
+    parts += ['## Disc robots among pillars', '', discs.__doc__.strip().split('\n\n')[1], '',
+              *disc_lines, '']
     parts += ['## Service round trip over DDS against k', '',
               'planner_node in its own process, one client, Fast DDS on this machine '
               '(`bench/service_roundtrip.py --sweep`); most of the time at large k is '
@@ -230,10 +233,13 @@ def main(argv=None):
     profiles = core_speed.profiles()
     print('==> against OMPL and straight lines', file=sys.stderr, flush=True)
     outcomes = peers.run(settings, progress)
+    print('==> disc robots among pillars', file=sys.stderr, flush=True)
+    disc_lines = discs.report(discs.quick_settings() if args.quick else discs.Settings())
     print('==> service round trip over DDS', file=sys.stderr, flush=True)
     service = service_sweep(args.quick)
     seconds = time.perf_counter() - start
-    write_markdown(figures, outcomes, settings, seconds, stages, profiles, service)
+    write_markdown(figures, outcomes, settings, seconds, stages, profiles, service,
+                   disc_lines)
     write_plot(figures, outcomes)
     print('\n'.join(headline(figures, outcomes)))
     print()
@@ -242,6 +248,8 @@ def main(argv=None):
     print(format_table(peers.breakdown_rows(outcomes, lambda q: q.k, 'k')))
     print()
     print(format_table([('figure', 'value', 'target')] + core_speed.summary_rows(figures)))
+    print()
+    print('\n'.join(disc_lines))
     print()
     print(service)
     print(f'\nwrote {RESULTS_MD} and {RESULTS_PNG} in {seconds / 60:.1f} min')
