@@ -48,6 +48,7 @@ EXPECTED_RESPONSE_FIELDS = {
     'projection_counts': 'sequence<uint32>',
     'dropped_configurations': 'sequence<uint32>',
     'min_clearance': 'double',
+    'min_gap': 'double',
     'planning_time': 'builtin_interfaces/Duration',
     'duration': 'builtin_interfaces/Duration',
     'paths': 'sequence<nav_msgs/Path>',

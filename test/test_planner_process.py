@@ -11,9 +11,9 @@ import subprocess
 from conftest import REPO_ROOT
 from conftest import venv_script
 import numpy as np
-from planner_helpers import scenario_plan
 from planner_helpers import Latest
 from planner_helpers import path_array
+from planner_helpers import scenario_plan
 import pytest
 import yaml
 
