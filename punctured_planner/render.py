@@ -92,7 +92,7 @@ def make_parser():
     domain.set_defaults(func=_domain)
     example = commands.add_parser('example', help='the example plan (PNG and/or GIF)')
     add_render_arguments(example)
-    example.add_argument('--variant', choices=('paper', 'spread'), default='spread',
+    example.add_argument('--variant', choices=('paper', 'spread', 'discs'), default='spread',
                          help='planner variant (default: %(default)s)')
     example.set_defaults(func=_example)
     return parser

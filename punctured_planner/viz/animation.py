@@ -10,6 +10,7 @@ never meet.
 import os
 
 from matplotlib.lines import Line2D
+from matplotlib.patches import Circle
 import numpy as np
 from PIL import Image
 
@@ -62,12 +63,20 @@ def _leg_label(plan, tau):
 
 
 class _Movers:
-    """The artists that move: one trail and one marker per robot, in one 2-D or 3-D axes."""
+    """
+    The artists that move: one trail and one marker per robot, in one 2-D or 3-D axes.
 
-    def __init__(self, ax, colours, three_d):
-        """Create empty trails and robot markers on ax."""
+    In 2-D a robot with a radius also gets its disc, to scale (``bodies``).
+    """
+
+    def __init__(self, ax, colours, three_d, radius=0.0):
+        """Create empty trails and robot markers (and discs of radius) on ax."""
         self.three_d = three_d
-        self.trails, self.robots = [], []
+        self.trails, self.robots, self.bodies = [], [], []
+        if radius > 0 and not three_d:
+            self.bodies = [ax.add_patch(Circle((0.0, 0.0), radius, fc=colour, ec='black',
+                                               lw=0.6, alpha=0.45, zorder=8))
+                           for colour in colours]
         for colour in colours:
             if three_d:
                 trail, = ax.plot([], [], [], color=colour, lw=2.6)
@@ -89,6 +98,8 @@ class _Movers:
             else:
                 trail.set_data(*points.T)
                 marker.set_data(*points[-1:].T)
+        for robot, body in enumerate(self.bodies):
+            body.set_center(tuple(history[-1, robot]))
 
 
 def _palette_of(image, colours=96):
@@ -128,9 +139,10 @@ def render_animation(plan, path, fps=20, seconds=8.0, dpi=80, title=None, max_sp
     movers = []
     if len(axes) == 2:
         movers.append((_Movers(axes[0], colours, True), positions))
-    movers.append((_Movers(axes[-1], colours, False), plane_view(plan)(positions)))
+    movers.append((_Movers(axes[-1], colours, False, plan.workspace.robot_radius),
+                   plane_view(plan)(positions)))
     dynamic = [heading_text] + [artist for mover, _ in movers
-                                for artist in mover.trails + mover.robots]
+                                for artist in mover.trails + mover.robots + mover.bodies]
     figure.canvas.draw()
     figure.set_layout_engine('none')
     for artist in dynamic:

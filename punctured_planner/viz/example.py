@@ -3,7 +3,8 @@ The example scenario of the pictures: 5 robots, 3 obstacles off one line, n = 3,
 
 The robots start in a row below the obstacles, meet in a ring around them
 (one robot right above an obstacle, so C_2 lies in a lower stratum and D
-moves) and end in a row above, in reverse order.
+moves) and end in a row above, in reverse order. For the 'discs' variant the
+robots are discs of radius 0.3 and the pillars of radius 0.2.
 """
 
 import numpy as np
@@ -18,7 +19,12 @@ EXAMPLE_CONFIGURATIONS = [
 ]
 
 
+EXAMPLE_ROBOT_RADIUS, EXAMPLE_OBSTACLE_RADIUS = 0.3, 0.2
+
+
 def example_plan(variant='spread'):
     """Return the plan of the example scenario (variant 'spread' unless told otherwise)."""
-    workspace = Workspace(EXAMPLE_OBSTACLES, variant=variant)
+    radii = ({'robot_radius': EXAMPLE_ROBOT_RADIUS, 'obstacle_radius': EXAMPLE_OBSTACLE_RADIUS}
+             if variant == 'discs' else {})
+    workspace = Workspace(EXAMPLE_OBSTACLES, variant=variant, **radii)
     return plan(workspace, np.array(EXAMPLE_CONFIGURATIONS))
