@@ -73,3 +73,17 @@ def test_tiny_but_resolvable_coordinates_plan_and_certify():
     p = plan(ws, [[[1e-9, 1e-9], [2e-9, 1e-9]], [[-1e-9, -1e-9], [3e-9, 2e-9]]])
     assert 0 < p.min_clearance <= 1e-9
     assert p.min_clearance >= p.clearance_bound * (1 - 1e-9)
+
+
+@pytest.mark.parametrize('robots', [3, 70])
+def test_one_pass_gives_both_certificates_of_bodies(robots):
+    """certify_bodies equals certify without and with radii (direct and pruned paths)."""
+    rng = np.random.default_rng(robots)
+    positions = rng.uniform(-5, 5, (6, robots, 2))
+    obstacles = rng.uniform(-5, 5, (4, 2))
+    radii = np.concatenate([np.full(robots, 0.05), rng.uniform(0.0, 0.5, 4)])
+    times = np.linspace(0.0, 1.0, 6)
+    clearance, gap = certificate.certify_bodies(times, positions, obstacles, radii)
+    assert clearance == certify(times, positions, obstacles)
+    assert gap == certify(times, positions, obstacles, radii)
+    assert gap.distance < clearance.distance

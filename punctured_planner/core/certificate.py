@@ -91,17 +91,28 @@ def _argmin_over_legs(start, end, legs, offsets=None):
     pair's own minimum over the legs counts, and the smallest gap may belong to
     a pair that is not the closest.
     """
-    squared, fractions = segment_minimum(start, end - start)
     if offsets is None:
+        squared, fractions = segment_minimum(start, end - start)
         leg, pair = divmod(int(np.argmin(squared)), squared.shape[1])
         return (float(np.sqrt(squared[leg, pair])), int(legs[leg]), int(pair),
                 float(fractions[leg, pair]))
-    per_pair_leg = np.argmin(squared, axis=0)
+    distance, leg, fraction = _per_pair_minima(start, end)
+    return _smallest(distance, leg, fraction, legs, offsets)
+
+
+def _per_pair_minima(start, end):
+    """Return each pair's (distance, leg, fraction) of its smallest distance over the legs."""
+    squared, fractions = segment_minimum(start, end - start)
+    leg = np.argmin(squared, axis=0)
     pairs = np.arange(squared.shape[1])
-    values = np.sqrt(squared[per_pair_leg, pairs]) - offsets
+    return np.sqrt(squared[leg, pairs]), leg, fractions[leg, pairs]
+
+
+def _smallest(distance, leg, fraction, legs, offsets):
+    """Return (value, leg, pair, fraction) of the pair whose distance - offset is smallest."""
+    values = distance - offsets
     pair = int(np.argmin(values))
-    leg = int(per_pair_leg[pair])
-    return float(values[pair]), int(legs[leg]), pair, float(fractions[leg, pair])
+    return float(values[pair]), int(legs[leg[pair]]), pair, float(fraction[pair])
 
 
 def _coordinate_first(points):
@@ -123,11 +134,16 @@ def _pairs_minimum(points, legs, a, b, offsets=None):
     return best
 
 
-def _direct_minimum(points, robot_count, obstacle_count, offsets=None):
-    """Return (value, leg, pair, fraction) over every pair and every leg at once."""
+def _relative(points, robot_count, obstacle_count):
+    """Return every pair's relative position at every breakpoint, (d, V, pairs)."""
     a, b = point_pairs(robot_count, obstacle_count)
     planes = _coordinate_first(points)
-    relative = planes[:, :, a] - planes[:, :, b]
+    return planes[:, :, a] - planes[:, :, b]
+
+
+def _direct_minimum(points, robot_count, obstacle_count, offsets=None):
+    """Return (value, leg, pair, fraction) over every pair and every leg at once."""
+    relative = _relative(points, robot_count, obstacle_count)
     return _argmin_over_legs(relative[:, :-1], relative[:, 1:],
                              np.arange(points.shape[0] - 1), offsets)
 
@@ -230,6 +246,42 @@ def _scale(points):
     return float(np.abs(points).max(initial=0.0))
 
 
+def _scaled(positions, obstacles, radii):
+    """
+    Return (points (V, k + r, d), radii, exponent, resolution), rescaled by 2^-exponent.
+
+    Far from unit scale the coordinates are multiplied by a power of two
+    (exact), so squared distances neither overflow nor fall into subnormals.
+    """
+    points = with_obstacles(positions, obstacles)
+    scale = _scale(points)
+    exponent = 0
+    if scale > 0 and not _UNSCALED[0] <= scale <= _UNSCALED[1]:
+        exponent = int(np.frexp(scale)[1])
+        points = np.ldexp(points, -exponent)
+        radii = None if radii is None else np.ldexp(radii, -exponent)
+    return points, radii, exponent, RELATIVE_RESOLUTION * scale
+
+
+def _clearance(found, times, k, exponent, resolution):
+    """Return the Clearance of a (value, leg, first, second, fraction) found by _closest."""
+    value, leg, first, second, fraction = found
+    value = float(np.ldexp(value, exponent))
+    tau = float(times[leg] + fraction * (times[leg + 1] - times[leg]))
+    if second >= k:
+        return Clearance(value, 'obstacle', (first, second - k), leg, fraction, tau,
+                         resolution)
+    return Clearance(value, 'robots', (first, second), leg, fraction, tau, resolution)
+
+
+def _nothing(positions, obstacles, resolution):
+    """Return the Clearance of a motion with no pair (one robot, no obstacle), or None."""
+    k, r = positions.shape[1], len(obstacles)
+    if k == 0 or (k == 1 and r == 0):
+        return Clearance(np.inf, 'none', (), 0, 0.0, 0.0, resolution)
+    return None
+
+
 def certify(times: np.ndarray, positions: np.ndarray, obstacles: np.ndarray,
             radii: np.ndarray | None = None) -> Clearance:
     """
@@ -239,24 +291,42 @@ def certify(times: np.ndarray, positions: np.ndarray, obstacles: np.ndarray,
     pair; the pruning for many robots drops only pairs that cannot be closest.
     With radii (k + r,), robots' then obstacles', the Clearance's distance is
     the smallest surface gap, |a - b| - radius_a - radius_b, and where it is.
-    Far from unit scale the coordinates are first multiplied by a power of two
-    (exact), so squared distances neither overflow nor fall into subnormals.
+    """
+    k = positions.shape[1]
+    points, radii, exponent, resolution = _scaled(positions, obstacles, radii)
+    nothing = _nothing(positions, obstacles, resolution)
+    if nothing is not None:
+        return nothing
+    return _clearance(_closest(points, k, radii), times, k, exponent, resolution)
+
+
+def certify_bodies(times: np.ndarray, positions: np.ndarray, obstacles: np.ndarray,
+                   radii: np.ndarray) -> tuple[Clearance, Clearance]:
+    """
+    Return (centre-distance Clearance, surface-gap Clearance) of the motion, exactly.
+
+    certify twice, but where every pair is evaluated on every leg (up to
+    _DIRECT_ROBOTS robots) both come from one pass: each pair's own minimum
+    over the legs gives the closest pair and the pair with the smallest gap.
     """
     k, r = positions.shape[1], len(obstacles)
-    points = with_obstacles(positions, obstacles)
-    scale = _scale(points)
-    resolution = RELATIVE_RESOLUTION * scale
-    if k == 0 or (k == 1 and r == 0):
-        return Clearance(np.inf, 'none', (), 0, 0.0, 0.0, resolution)
-    exponent = 0
-    if scale > 0 and not _UNSCALED[0] <= scale <= _UNSCALED[1]:
-        exponent = int(np.frexp(scale)[1])
-        points = np.ldexp(points, -exponent)
-        radii = None if radii is None else np.ldexp(radii, -exponent)
-    distance, leg, first, second, fraction = _closest(points, k, radii)
-    distance = float(np.ldexp(distance, exponent))
-    tau = float(times[leg] + fraction * (times[leg + 1] - times[leg]))
-    if second >= k:
-        return Clearance(distance, 'obstacle', (first, second - k), leg, fraction, tau,
-                         resolution)
-    return Clearance(distance, 'robots', (first, second), leg, fraction, tau, resolution)
+    points, radii, exponent, resolution = _scaled(positions, obstacles, radii)
+    nothing = _nothing(positions, obstacles, resolution)
+    if nothing is not None:
+        return nothing, nothing
+    v, _, d = points.shape
+    a, b = point_pairs(k, r)
+    if k > _DIRECT_ROBOTS or a.size * v * d > _CHUNK_ELEMENTS:
+        return (_clearance(_closest(points, k), times, k, exponent, resolution),
+                _clearance(_closest(points, k, radii), times, k, exponent, resolution))
+    relative = _relative(points, k, r)
+    start, end = relative[:, :-1], relative[:, 1:]
+    distance, per_pair_leg, per_pair_fraction = _per_pair_minima(start, end)
+    legs = np.arange(v - 1)
+    found = []
+    for offsets in (np.zeros(a.size), radii[a] + radii[b]):
+        value, leg, pair, fraction = _smallest(distance, per_pair_leg, per_pair_fraction, legs,
+                                               offsets)
+        found.append(_clearance((value, leg, int(a[pair]), int(b[pair]), fraction), times, k,
+                                exponent, resolution))
+    return found[0], found[1]

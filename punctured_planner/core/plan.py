@@ -17,7 +17,7 @@ import numpy.typing as npt
 from scipy.spatial import cKDTree
 
 from . import discs
-from .certificate import certify, Clearance
+from .certificate import certify, certify_bodies, Clearance
 from .complexity import domain_range, sequential_complexity
 from .deformations import desingularize, desingularizing_shift, spread
 from .errors import ErrorCode, PlanningError
@@ -87,7 +87,17 @@ class Plan:
     @cached_property
     def clearance(self) -> Clearance:
         """Return the exact Clearance certificate (computed once, on first use)."""
+        if self.workspace.has_bodies:
+            return self._certificates[0]
         return certify(self.times, self.positions, self.workspace.obstacles)
+
+    @cached_property
+    def _certificates(self) -> tuple[Clearance, Clearance]:
+        """Return (clearance, gap) with bodies, both from one pass over pairs and legs."""
+        workspace = self.workspace
+        k = self.positions.shape[1]
+        radii = np.concatenate([np.full(k, workspace.robot_radius), workspace.obstacle_radii])
+        return certify_bodies(self.times, self.positions, workspace.obstacles, radii)
 
     @property
     def min_clearance(self) -> float:
@@ -102,12 +112,9 @@ class Plan:
         The gap is the centre distance - 2R for two robots and - R - rho_j for a
         robot and obstacle j; with no radius it is the clearance itself.
         """
-        workspace = self.workspace
-        if not workspace.has_bodies:
+        if not self.workspace.has_bodies:
             return self.clearance
-        k = self.positions.shape[1]
-        radii = np.concatenate([np.full(k, workspace.robot_radius), workspace.obstacle_radii])
-        return certify(self.times, self.positions, workspace.obstacles, radii)
+        return self._certificates[1]
 
     @property
     def min_gap(self) -> float:
