@@ -14,6 +14,7 @@ would publish it.
 """
 
 import argparse
+import contextlib
 import os
 import sys
 import time
@@ -59,23 +60,40 @@ def call_service(executor, client, request, timeout_sec):
     return future.result()
 
 
-def _call(args):
+@contextlib.contextmanager
+def _ros_session():
+    """Yield (node, executor) in a private rclpy Context; shut everything down after."""
     import rclpy
     from rclpy.executors import SingleThreadedExecutor
-
-    from punctured_planner_interfaces.srv import PlanSequence
-
-    try:
-        request = build_request(load_request(args.request))
-    except (OSError, yaml.YAMLError, ValueError) as error:
-        print('punctured-planner: bad request: %s' % error, file=sys.stderr)
-        return EXIT_USAGE
 
     context = rclpy.context.Context()
     rclpy.init(context=context)
     executor = SingleThreadedExecutor(context=context)
     node = rclpy.create_node('punctured_planner_cli', context=context)
     try:
+        yield node, executor
+    finally:
+        executor.shutdown()
+        node.destroy_node()
+        rclpy.try_shutdown(context=context)
+
+
+def _request(args):
+    """Return the request of args.request, or None after saying why it is bad."""
+    try:
+        return build_request(load_request(args.request))
+    except (OSError, yaml.YAMLError, ValueError) as error:
+        print('punctured-planner: bad request: %s' % error, file=sys.stderr)
+        return None
+
+
+def _call(args):
+    from punctured_planner_interfaces.srv import PlanSequence
+
+    request = _request(args)
+    if request is None:
+        return EXIT_USAGE
+    with _ros_session() as (node, executor):
         client = node.create_client(PlanSequence, args.service)
         if not client.wait_for_service(timeout_sec=args.wait):
             print('punctured-planner: service %s not available after %.1f s'
@@ -88,10 +106,6 @@ def _call(args):
                   % (args.service, args.timeout), file=sys.stderr)
             return EXIT_NO_SERVICE
         return print_response(response, args.no_paths)
-    finally:
-        executor.shutdown()
-        node.destroy_node()
-        rclpy.try_shutdown(context=context)
 
 
 def reset_obstacles(node, executor, planner_node, timeout_sec):
@@ -128,20 +142,9 @@ def reset_obstacles(node, executor, planner_node, timeout_sec):
 
 
 def _reset(args):
-    import rclpy
-    from rclpy.executors import SingleThreadedExecutor
-
-    context = rclpy.context.Context()
-    rclpy.init(context=context)
-    executor = SingleThreadedExecutor(context=context)
-    node = rclpy.create_node('punctured_planner_cli', context=context)
-    executor.add_node(node)
-    try:
+    with _ros_session() as (node, executor):
+        executor.add_node(node)
         problem = reset_obstacles(node, executor, args.node, args.wait)
-    finally:
-        executor.shutdown()
-        node.destroy_node()
-        rclpy.try_shutdown(context=context)
     if problem:
         print('punctured-planner: %s' % problem, file=sys.stderr)
         return EXIT_NO_SERVICE
@@ -201,10 +204,8 @@ def _plan(args):
     except (OSError, yaml.YAMLError, ValueError) as error:
         print('punctured-planner: bad parameter file: %s' % error, file=sys.stderr)
         return EXIT_USAGE
-    try:
-        request = build_request(load_request(args.request))
-    except (OSError, yaml.YAMLError, ValueError) as error:
-        print('punctured-planner: bad request: %s' % error, file=sys.stderr)
+    request = _request(args)
+    if request is None:
         return EXIT_USAGE
     outcome = offline_plan(request, settings)
     if outcome.exception is not None:

@@ -196,7 +196,7 @@ class PlannerNode(Node):
             return
         with self._lock:
             self._obstacles = obstacles
-        self.get_logger().info('obstacles: %s' % obstacles.describe())
+        self.get_logger().debug('obstacles: %s' % obstacles.describe())
 
     def _on_robot_states(self, msg):
         state = RobotState(conversions.pose_array_positions(msg),
