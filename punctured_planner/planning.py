@@ -167,6 +167,16 @@ def _point(point):
     return '(%s)' % ', '.join('%.6g' % v for v in np.asarray(point, dtype=float).tolist())
 
 
+def _check_poses(settings, robot_count, breakpoints, samples):
+    """REQUEST_OVER_LIMITS when robot_count paths through breakpoints would pass max_poses."""
+    poses = robot_count * ((breakpoints - 1) * (samples + 1) + 1)
+    if poses > settings.max_poses:
+        _fail(ErrorCode.REQUEST_OVER_LIMITS, 'the answer would hold %d poses (%d robots x '
+              '%d poses), more than max_poses %d' % (poses, robot_count,
+                                                     poses // max(robot_count, 1),
+                                                     settings.max_poses))
+
+
 def _fail(code, message, configuration=None, robots=(), obstacle=None):
     raise PlanningError(code, message, configuration=configuration, robots=robots,
                         obstacle=obstacle)
@@ -351,6 +361,9 @@ class PlanSequenceHandler:
         planning_time = time.perf_counter() - started
         start_ns = int(now_ns) + int(round(planning_time * 1e9))
         max_speed = gathered.max_speed
+        if settings.core_variant not in SCHEDULES:
+            _check_poses(settings, gathered.counts[0], len(the_plan.times),
+                         gathered.samples_per_leg)
         self._check_duration(the_plan, max_speed, start_ns)
         samples = the_plan.sample(gathered.samples_per_leg, max_speed)
         paths = conversions.plan_to_paths(samples, checked.orientations, settings.frame_id,
@@ -376,13 +389,8 @@ class PlanSequenceHandler:
             _fail(ErrorCode.REQUEST_OVER_LIMITS, 'samples_per_leg %d is more than %d'
                   % (samples, MAX_SAMPLES_PER_LEG))
         schedule = SCHEDULES.get(settings.core_variant)
-        if schedule is None:
-            return  # no fixed legs ('discs'): its breakpoints are known only once planned
-        poses = k * ((schedule.breakpoint_count(n) - 1) * (samples + 1) + 1)
-        if poses > settings.max_poses:
-            _fail(ErrorCode.REQUEST_OVER_LIMITS, 'the answer would hold %d poses (%d robots x '
-                  '%d poses), more than max_poses %d' % (poses, k, poses // max(k, 1),
-                                                         settings.max_poses))
+        if schedule is not None:  # 'discs' has no fixed legs: checked once planned
+            _check_poses(settings, k, schedule.breakpoint_count(n), samples)
 
     @staticmethod
     def _check_duration(the_plan, max_speed, start_ns):

@@ -48,6 +48,23 @@ def test_over_limit_requests_are_refused_before_conversion(monkeypatch):
     assert converted == []
 
 
+def test_discs_answers_over_max_poses_are_refused_once_planned():
+    """'discs' has no fixed legs: its pose count is checked against max_poses after planning."""
+    from punctured_planner_interfaces.srv import PlanSequence
+    flat = [v for o in OBSTACLES for v in o]
+    planned = PlanSequenceHandler().handle(
+        make_request(), PlanSequence.Response(),
+        snapshot(obstacles=flat, robot_radius=0.1, samples_per_leg=0), 0)
+    poses = 4 * len(planned.plan.times)
+    limited = snapshot(obstacles=flat, robot_radius=0.1, samples_per_leg=0,
+                       max_poses=poses - 1)
+    outcome = PlanSequenceHandler().handle(make_request(), PlanSequence.Response(), limited, 0)
+    assert outcome.response.error_code == PlanSequence.Response.REQUEST_OVER_LIMITS
+    assert 'more than max_poses %d' % (poses - 1) in outcome.response.error_msg
+    enough = snapshot(obstacles=flat, robot_radius=0.1, samples_per_leg=0, max_poses=poses)
+    assert PlanSequenceHandler().handle(make_request(), PlanSequence.Response(), enough, 0).ok
+
+
 def test_array_holding_dataclasses_compare_by_identity():
     """Frame, ObstacleSet, RobotState, PlaneView: == and hash work (no numpy ValueError)."""
     from punctured_planner.core import Workspace
