@@ -30,6 +30,10 @@ _UNSCALED = (2.0 ** -60, 2.0 ** 60)
 _DIRECT_ROBOTS = 64
 # Elements of (legs x pairs x d) arrays handled per chunk: bounds peak memory.
 _CHUNK_ELEMENTS = 1 << 22
+# Elements of the (d x legs x pairs) arrays of one pass of the closed form: a few
+# hundred kB stay in cache and in malloc's arenas; one pass over megabytes is about
+# four times slower (fresh pages for every temporary).
+_PASS_ELEMENTS = 1 << 16
 
 
 @dataclass(frozen=True)
@@ -73,7 +77,9 @@ def segment_minimum(start: np.ndarray, velocity: np.ndarray) -> tuple[np.ndarray
     """
     speed2 = _dot(velocity, velocity)
     t = _dot(start, velocity)
-    np.divide(t, speed2, out=t, where=speed2 > 0)
+    # Where nothing moves t is 0 already (a dot product with 0): any divisor keeps it.
+    np.maximum(speed2, np.finfo(float).tiny, out=speed2)
+    np.divide(t, speed2, out=t)
     np.negative(t, out=t)
     np.maximum(t, 0.0, out=t)
     np.minimum(t, 1.0, out=t)
@@ -96,16 +102,41 @@ def _argmin_over_legs(start, end, legs, offsets=None):
         leg, pair = divmod(int(np.argmin(squared)), squared.shape[1])
         return (float(np.sqrt(squared[leg, pair])), int(legs[leg]), int(pair),
                 float(fractions[leg, pair]))
-    distance, leg, fraction = _per_pair_minima(start, end)
+    relative = np.concatenate([start, end[:, -1:]], axis=1)
+    distance, leg, fraction = _per_pair_minima(relative, np.arange(relative.shape[2]))
     return _smallest(distance, leg, fraction, legs, offsets)
 
 
-def _per_pair_minima(start, end):
-    """Return each pair's (distance, leg, fraction) of its smallest distance over the legs."""
-    squared, fractions = segment_minimum(start, end - start)
-    leg = np.argmin(squared, axis=0)
-    pairs = np.arange(squared.shape[1])
-    return np.sqrt(squared[leg, pairs]), leg, fractions[leg, pairs]
+def _per_pair_minima(planes, a, b=None):
+    """
+    Return each pair's (distance, leg, fraction) of its smallest distance over the legs.
+
+    planes is (d, V, N): points at the breakpoints, coordinate first; the pairs
+    are (a[i], b[i]), or with b None the points themselves are the pairs'
+    relative positions (a selects them). The legs are taken a cache-sized pass
+    at a time (_PASS_ELEMENTS), each pass gathering its own pairs.
+    """
+    d, v, _ = planes.shape
+    count = a.size
+    pairs = np.arange(count)
+    best = np.full(count, np.inf)
+    leg = np.zeros(count, dtype=int)
+    fraction = np.zeros(count)
+    step = max(1, _PASS_ELEMENTS // max(1, d * count))
+    for first in range(0, v - 1, step):
+        last = min(first + step, v - 1)
+        window = planes[:, first:last + 1]
+        relative = (np.take(window, a, axis=-1) if b is None
+                    else _pair_differences(window, a, b))
+        start, end = relative[:, :-1], relative[:, 1:]
+        squared, fractions = segment_minimum(start, end - start)
+        pass_leg = np.argmin(squared, axis=0)
+        value = squared[pass_leg, pairs]
+        better = value < best
+        best[better] = value[better]
+        leg[better] = first + pass_leg[better]
+        fraction[better] = fractions[pass_leg, pairs][better]
+    return np.sqrt(best), leg, fraction
 
 
 def _smallest(distance, leg, fraction, legs, offsets):
@@ -120,6 +151,16 @@ def _coordinate_first(points):
     return np.ascontiguousarray(np.moveaxis(points, 2, 0))
 
 
+def _pair_differences(planes, a, b):
+    """
+    Return planes[..., a] - planes[..., b], contiguous with the pairs last.
+
+    np.take keeps that layout; a fancy index on the last axis would put the pairs
+    first in memory and make every later pass strided (about 3x slower).
+    """
+    return np.take(planes, a, axis=-1) - np.take(planes, b, axis=-1)
+
+
 def _pairs_minimum(points, legs, a, b, offsets=None):
     """Return (value, leg, pair, fraction) of the closest pair (a[i], b[i]) over legs."""
     best = (np.inf, 0, 0, 0.0)
@@ -127,25 +168,19 @@ def _pairs_minimum(points, legs, a, b, offsets=None):
     step = max(1, _CHUNK_ELEMENTS // max(1, a.size * points.shape[2]))
     for first in range(0, legs.size, step):
         chunk = legs[first:first + step]
-        start = planes[:, chunk][:, :, a] - planes[:, chunk][:, :, b]
-        end = planes[:, chunk + 1][:, :, a] - planes[:, chunk + 1][:, :, b]
+        start = _pair_differences(planes[:, chunk], a, b)
+        end = _pair_differences(planes[:, chunk + 1], a, b)
         best = min(best, _argmin_over_legs(start, end, chunk, offsets),
                    key=lambda item: item[0])
     return best
 
 
-def _relative(points, robot_count, obstacle_count):
-    """Return every pair's relative position at every breakpoint, (d, V, pairs)."""
-    a, b = point_pairs(robot_count, obstacle_count)
-    planes = _coordinate_first(points)
-    return planes[:, :, a] - planes[:, :, b]
-
-
 def _direct_minimum(points, robot_count, obstacle_count, offsets=None):
-    """Return (value, leg, pair, fraction) over every pair and every leg at once."""
-    relative = _relative(points, robot_count, obstacle_count)
-    return _argmin_over_legs(relative[:, :-1], relative[:, 1:],
-                             np.arange(points.shape[0] - 1), offsets)
+    """Return (value, leg, pair, fraction) over every pair and every leg."""
+    a, b = point_pairs(robot_count, obstacle_count)
+    distance, leg, fraction = _per_pair_minima(_coordinate_first(points), a, b)
+    return _smallest(distance, leg, fraction, np.arange(points.shape[0] - 1),
+                     0.0 if offsets is None else offsets)
 
 
 def _breakpoint_bound(positions, obstacles):
@@ -319,9 +354,8 @@ def certify_bodies(times: np.ndarray, positions: np.ndarray, obstacles: np.ndarr
     if k > _DIRECT_ROBOTS or a.size * v * d > _CHUNK_ELEMENTS:
         return (_clearance(_closest(points, k), times, k, exponent, resolution),
                 _clearance(_closest(points, k, radii), times, k, exponent, resolution))
-    relative = _relative(points, k, r)
-    start, end = relative[:, :-1], relative[:, 1:]
-    distance, per_pair_leg, per_pair_fraction = _per_pair_minima(start, end)
+    planes = _coordinate_first(points)
+    distance, per_pair_leg, per_pair_fraction = _per_pair_minima(planes, a, b)
     legs = np.arange(v - 1)
     found = []
     for offsets in (np.zeros(a.size), radii[a] + radii[b]):
