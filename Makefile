@@ -31,7 +31,7 @@ hash = $(shell { echo $(1); cat $(1); } 2>/dev/null | sha256sum | cut -c1-16)
 
 WHEELS_KEY := $(call hash,requirements.txt constraints.txt)
 IFACE_INPUTS := $(sort $(wildcard $(IFACE)/CMakeLists.txt $(IFACE)/package.xml \
-	$(IFACE)/srv/*.srv $(IFACE)/msg/*.msg))
+	$(IFACE)/srv/*.srv $(IFACE)/msg/*.msg $(IFACE)/action/*.action))
 IFACE_KEY := $(call hash,$(IFACE_INPUTS))
 PROJECT_KEY := $(call hash,setup.py setup.cfg package.xml)
 
@@ -71,13 +71,15 @@ PIP_INSTALL := $(PIP) install --progress-bar off --disable-pip-version-check -q
 # this machine's pip configuration names local index folders that may be empty
 PIP_FILTER := { grep -v -e 'is ignored: it is neither a file nor a directory' || true; }
 
-.PHONY: help setup test run bench lock clean
+.PHONY: help setup test run bench demo lock clean
 
 help:
 	@echo 'make run    start the planner node in the foreground (after setup)'
 	@echo 'make test   run the whole test suite: unit, lint, DDS, colcon (after setup)'
 	@echo 'make setup  create .venv, install pinned packages, build the interfaces'
 	@echo 'make bench  benchmarks beside OMPL (a few minutes): bench/results.md, results.png'
+	@echo '           and plan execution over DDS: bench/execution.md'
+	@echo 'make demo   simulated fleet + planner + executor: demo.mcap, demo.gif'
 	@echo 'make lock   re-resolve requirements.txt into constraints.txt'
 	@echo 'make clean  remove .venv and caches'
 
@@ -123,6 +125,11 @@ test: setup
 bench: setup
 	@$(PIP_INSTALL) -r bench/requirements.txt -c constraints.txt 2>&1 | $(PIP_FILTER)
 	$(VPY) bench/run_all.py $(BENCH_ARGS)
+	$(VPY) bench/execution.py $(BENCH_ARGS)
+
+# A simulated fleet, the planner and the executor: plan, execute, record (about a minute).
+demo: setup
+	$(VPY) -m punctured_planner.demo
 
 # Discovery stays on this machine unless ROS_AUTOMATIC_DISCOVERY_RANGE says otherwise.
 run: setup

@@ -25,6 +25,8 @@ setup(
     entry_points={
         'console_scripts': [
             'planner_node = punctured_planner.planner_node:main',
+            'plan_executor = punctured_planner.executor_node:main',
+            'fleet_sim = punctured_planner.fleet_sim_node:main',
             'punctured-planner = punctured_planner.cli:main',
         ],
     },

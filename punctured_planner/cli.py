@@ -60,6 +60,17 @@ def call_service(executor, client, request, timeout_sec):
     return future.result()
 
 
+def spin_until(executor, predicate, timeout_sec):
+    """Spin ``executor`` (spin_once) until predicate() is true; return whether it became so."""
+    deadline = time.monotonic() + timeout_sec
+    while not predicate():
+        remaining = deadline - time.monotonic()
+        if remaining <= 0:
+            return False
+        executor.spin_once(timeout_sec=min(remaining, 0.05))
+    return True
+
+
 @contextlib.contextmanager
 def _ros_session():
     """Yield (node, executor) in a private rclpy Context; shut everything down after."""

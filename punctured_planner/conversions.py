@@ -26,11 +26,16 @@ Conventions:
 
 from builtin_interfaces.msg import Duration
 from builtin_interfaces.msg import Time
+from geometry_msgs.msg import Point
 from geometry_msgs.msg import PoseStamped
 from nav_msgs.msg import Path
 import numpy as np
 from std_msgs.msg import Header
 from std_msgs.msg import UInt32
+
+from .execution import Bodies
+from .execution import Reference
+from .execution import tracking_tolerance
 
 IDENTITY = (0.0, 0.0, 0.0, 1.0)
 
@@ -202,6 +207,7 @@ def fill_response(response, plan, paths, planning_time, max_speed, waypoints, dr
     response.paths = paths
     response.waypoint_indices = [int(i) for i in np.asarray(waypoints).tolist()]
     response.dropped_configurations = [int(m) for m in dropped]
+    response.tracking_tolerance = tracking_tolerance(plan.min_gap)
     return response
 
 
@@ -224,4 +230,64 @@ def fill_error(response, code, message, planning_time=0.0, clearance=None, gap=N
     response.paths = []
     response.waypoint_indices = []
     response.dropped_configurations = []
+    response.plan_id = 0
+    response.tracking_tolerance = 0.0
     return response
+
+
+# ---------------------------------------------------------------- the plan for execution
+
+def plan_message(outcome, settings):
+    """
+    Return the punctured_planner_interfaces/Plan of a successful Outcome (topic ``plan``).
+
+    The bodies are the workspace's (robot radius, obstacles and their radii); the
+    tracking tolerance is execution.tracking_tolerance(min_gap).
+    """
+    from punctured_planner_interfaces.msg import Plan
+    workspace = outcome.plan.workspace
+    obstacles = [Point(x=x, y=y, z=z) for x, y, z in
+                 to_xyz(workspace.obstacles, settings.plane_z).reshape(-1, 3).tolist()]
+    min_gap = float(outcome.plan.min_gap)
+    return Plan(plan_id=int(outcome.plan_id), robot_names=list(outcome.names),
+                paths=list(outcome.paths), max_speed=float(outcome.max_speed),
+                robot_radius=float(workspace.robot_radius), obstacles=obstacles,
+                obstacle_radii=np.asarray(workspace.obstacle_radii, dtype=float).tolist(),
+                min_gap=min_gap, tracking_tolerance=tracking_tolerance(min_gap))
+
+
+def path_arrays(path):
+    """Return (stamps ns (M,), positions (M, 3), orientations (M, 4)) of a Path's poses."""
+    rows = [(stamp_to_ns(p.header.stamp), p.pose.position.x, p.pose.position.y,
+             p.pose.position.z, p.pose.orientation.x, p.pose.orientation.y,
+             p.pose.orientation.z, p.pose.orientation.w) for p in path.poses]
+    stamps = np.array([row[0] for row in rows], dtype=np.int64)
+    values = np.array([row[1:] for row in rows], dtype=float).reshape(-1, 7)
+    return stamps, values[:, :3], values[:, 3:]
+
+
+def plan_reference(msg):
+    """
+    Return the execution.Reference of a Plan message (seconds from its first stamp).
+
+    Raises ValueError when the paths do not share their stamps, as a plan's must.
+    """
+    arrays = [path_arrays(path) for path in msg.paths]
+    stamps = [a[0] for a in arrays]
+    if not stamps or stamps[0].size == 0:
+        raise ValueError('plan %d has no poses' % msg.plan_id)
+    for name, robot_stamps in zip(msg.robot_names, stamps):
+        if not np.array_equal(robot_stamps, stamps[0]):
+            raise ValueError('plan %d: the path of %s does not have the stamps of %s'
+                             % (msg.plan_id, name, msg.robot_names[0]))
+    seconds = (stamps[0] - stamps[0][0]) * 1e-9
+    positions = np.stack([a[1] for a in arrays], axis=1)
+    orientations = normalized_quaternions(np.stack([a[2] for a in arrays], axis=1))
+    return Reference(seconds, positions, orientations)
+
+
+def plan_bodies(msg):
+    """Return the execution.Bodies of a Plan message (robot radius, obstacles and radii)."""
+    obstacles = np.array([(p.x, p.y, p.z) for p in msg.obstacles], dtype=float).reshape(-1, 3)
+    return Bodies(float(msg.robot_radius), obstacles,
+                  np.asarray(msg.obstacle_radii, dtype=float).reshape(-1))

@@ -268,7 +268,7 @@ def load_parameter_file(path, node_name=NODE_NAME):
     return values
 
 
-def descriptor(spec):
+def descriptor(spec, read_only=False):
     """Return the rcl_interfaces ParameterDescriptor of a parameter (imports rclpy types)."""
     from rcl_interfaces.msg import FloatingPointRange
     from rcl_interfaces.msg import IntegerRange
@@ -284,7 +284,8 @@ def descriptor(spec):
     }
     result = ParameterDescriptor(name=spec.name, type=kinds[spec.kind],
                                  description=spec.description,
-                                 additional_constraints=spec.constraints)
+                                 additional_constraints=spec.constraints,
+                                 read_only=read_only)
     # Doubles accept YAML integers (plane_z: 0) and arrays accept [] (an untyped
     # empty list): their type is checked by settings_from_values instead.
     result.dynamic_typing = spec.kind in ('double', 'string_array', 'double_array')
@@ -295,3 +296,10 @@ def descriptor(spec):
                                                           to_value=float(spec.high),
                                                           step=0.0)]
     return result
+
+
+def parameter_value(spec, value):
+    """Return value converted to the parameter's kind and checked; raise ValueError (reason)."""
+    value = _coerce(spec, value)
+    _check_value(spec, value)
+    return value

@@ -36,6 +36,7 @@ from geometry_msgs.msg import PoseArray
 from nav_msgs.msg import Odometry
 from nav_msgs.msg import Path
 import numpy as np
+from punctured_planner_interfaces.msg import Plan
 from punctured_planner_interfaces.srv import PlanSequence
 from rcl_interfaces.msg import SetParametersResult
 import rclpy
@@ -93,6 +94,7 @@ class PlannerNode(Node):
         self._lock = threading.Lock()
         self._handler = PlanSequenceHandler()
         self._request_count = 0
+        self._plan_count = 0
         for spec in PARAMETERS:
             self.declare_parameter(spec.name, spec.default, descriptor(spec))
         self._settings = settings_from_values(self._parameter_values())
@@ -115,7 +117,8 @@ class PlannerNode(Node):
         self._update_odometry_subscriptions(self._settings.robot_names)
         self._latched_publishers = {}  # relative topic -> publisher
         self._latched_names = []
-        for topic, msg_type in (('domain_index', UInt32), ('plan_markers', MarkerArray)):
+        for topic, msg_type in (('domain_index', UInt32), ('plan_markers', MarkerArray),
+                                ('plan', Plan)):
             self._publisher(topic, msg_type)
         self._service = self.create_service(PlanSequence, 'plan_sequence',
                                             self._on_plan_sequence)
@@ -260,6 +263,8 @@ class PlannerNode(Node):
                        snapshot.describe()))
         outcome = self._handler.handle(request, response, snapshot, now_ns)
         if outcome.ok:
+            self._plan_count += 1
+            outcome.plan_id = response.plan_id = self._plan_count
             try:
                 self._publish(outcome, snapshot.settings)
             except Exception as error:  # never crash the service

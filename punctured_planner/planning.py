@@ -115,6 +115,7 @@ class Outcome:
     max_speed: float = 0.0
     exception: BaseException | None = None
     dropped: list[int] | None = None  # request configurations that repeated the state
+    plan_id: int = 0  # the id the node published the plan under (0: not published)
 
     @property
     def ok(self) -> bool:

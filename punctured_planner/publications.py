@@ -15,6 +15,7 @@ from visualization_msgs.msg import Marker
 from visualization_msgs.msg import MarkerArray
 
 from .conversions import domain_index_message
+from .conversions import plan_message
 from .conversions import robot_names
 from .conversions import time_from_ns
 from .conversions import to_xyz
@@ -119,7 +120,9 @@ def plan_messages(outcome, settings):
     """
     Return [(topic, message)] of a successful planning Outcome, as the node publishes them.
 
-    Topics are relative: ``<robot>/plan`` per robot, ``plan_markers``, ``domain_index``.
+    Topics are relative: ``<robot>/plan`` per robot, ``plan_markers``, ``domain_index``,
+    then ``plan`` (the Plan message, last: an executor never sees a plan whose paths are
+    not out).
     """
     messages = [('%s/plan' % name.strip('/'), path)
                 for name, path in zip(outcome.names, outcome.paths)]
@@ -127,4 +130,5 @@ def plan_messages(outcome, settings):
                                                   outcome.start_ns, settings.plane_z,
                                                   outcome.names, outcome.max_speed)))
     messages.append(('domain_index', domain_index_message(outcome.plan)))
+    messages.append(('plan', plan_message(outcome, settings)))
     return messages

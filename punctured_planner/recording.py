@@ -21,6 +21,8 @@ import importlib
 import os
 import re
 
+import numpy as np
+
 _SEPARATOR = '=' * 80
 _PRIMITIVES = {'bool', 'byte', 'char', 'float32', 'float64', 'int8', 'uint8', 'int16',
                'uint16', 'int32', 'uint32', 'int64', 'uint64', 'string', 'wstring'}
@@ -110,8 +112,8 @@ def write_mcap(path, messages, log_time_ns, metadata=None):
     Write [(topic, message)] to an MCAP file at ``path``; return the path.
 
     Each message is serialised by rclpy (exact CDR) and logged at
-    ``log_time_ns``; metadata (dict of str) goes into a ``punctured_planner``
-    metadata record.
+    ``log_time_ns``: one time for all, or a sequence with one per message;
+    metadata (dict of str) goes into a ``punctured_planner`` metadata record.
     """
     from mcap.well_known import MessageEncoding
     from mcap.well_known import Profile
@@ -134,8 +136,9 @@ def write_mcap(path, messages, log_time_ns, metadata=None):
                 channels[topic] = writer.register_channel(
                     topic=topic, message_encoding=MessageEncoding.CDR,
                     schema_id=schemas[type_name])
-            writer.add_message(channel_id=channels[topic], log_time=int(log_time_ns),
-                               publish_time=int(log_time_ns), sequence=sequence,
+            stamp = int(log_time_ns if np.ndim(log_time_ns) == 0 else log_time_ns[sequence])
+            writer.add_message(channel_id=channels[topic], log_time=stamp,
+                               publish_time=stamp, sequence=sequence,
                                data=serialize_message(message))
         if metadata:
             writer.add_metadata('punctured_planner',

@@ -53,7 +53,33 @@ EXPECTED_RESPONSE_FIELDS = {
     'duration': 'builtin_interfaces/Duration',
     'paths': 'sequence<nav_msgs/Path>',
     'waypoint_indices': 'sequence<uint32>',
+    'plan_id': 'uint64',
+    'tracking_tolerance': 'double',
 }
+
+EXPECTED_PLAN_FIELDS = {
+    'plan_id': 'uint64',
+    'robot_names': 'sequence<string>',
+    'paths': 'sequence<nav_msgs/Path>',
+    'max_speed': 'double',
+    'robot_radius': 'double',
+    'obstacles': 'sequence<geometry_msgs/Point>',
+    'obstacle_radii': 'sequence<double>',
+    'min_gap': 'double',
+    'tracking_tolerance': 'double',
+}
+
+EXPECTED_EXECUTE_PLAN = {
+    'Goal': {'plan_id': 'uint64'},
+    'Result': {'error_code': 'uint16', 'error_msg': 'string', 'plan_id': 'uint64',
+               'executed_duration': 'builtin_interfaces/Duration',
+               'max_tracking_errors': 'sequence<double>', 'min_gap': 'double'},
+    'Feedback': {'plan_time': 'double', 'plan_duration': 'double', 'clock_rate': 'double',
+                 'max_tracking_errors': 'sequence<double>', 'min_gap': 'double',
+                 'stale_robots': 'sequence<string>'},
+}
+EXECUTE_PLAN_CODES = {'NONE': 0, 'NO_PLAN': 1, 'UNKNOWN_ROBOTS': 2, 'FRAME_MISMATCH': 3,
+                      'UNSAFE_PLAN': 4, 'CANCELED': 5, 'PREEMPTED': 6, 'UNKNOWN': 99}
 
 
 def _plan_sequence():
@@ -83,6 +109,19 @@ def test_fields_and_types():
     plan_sequence = _plan_sequence()
     assert plan_sequence.Request.get_fields_and_field_types() == EXPECTED_REQUEST_FIELDS
     assert plan_sequence.Response.get_fields_and_field_types() == EXPECTED_RESPONSE_FIELDS
+
+
+def test_plan_message_and_execute_plan_action():
+    from punctured_planner_interfaces.action import ExecutePlan
+    from punctured_planner_interfaces.msg import Plan
+    assert Plan.get_fields_and_field_types() == EXPECTED_PLAN_FIELDS
+    for part, fields in EXPECTED_EXECUTE_PLAN.items():
+        assert getattr(ExecutePlan, part).get_fields_and_field_types() == fields, part
+    result = ExecutePlan.Result
+    declared = {name: getattr(result, name) for name in dir(result)
+                if name.isupper() and isinstance(getattr(result, name), int)}
+    assert declared == EXECUTE_PLAN_CODES
+    assert ExecutePlan.Goal().plan_id == 0
 
 
 def test_request_defaults():

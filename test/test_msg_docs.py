@@ -35,9 +35,10 @@ def parse_interface(path):
 
 
 def interface_files():
-    """Return every .srv and .msg file of the interface package."""
+    """Return every .srv, .msg and .action file of the interface package."""
     return sorted(glob.glob(os.path.join(INTERFACES, 'srv', '*.srv'))
-                  + glob.glob(os.path.join(INTERFACES, 'msg', '*.msg')))
+                  + glob.glob(os.path.join(INTERFACES, 'msg', '*.msg'))
+                  + glob.glob(os.path.join(INTERFACES, 'action', '*.action')))
 
 
 def test_every_interface_has_a_page():
@@ -62,6 +63,19 @@ def test_page_names_every_field_and_constant(path):
             else:
                 assert any(row.startswith('| %s | `%s` |' % (value, field))
                            for row in rows), 'constant %s=%s not documented' % (field, value)
+
+
+def test_every_kind_of_interface_is_checked():
+    names = {os.path.basename(path) for path in interface_files()}
+    assert {'PlanSequence.srv', 'Plan.msg', 'ExecutePlan.action'} <= names
+
+
+def test_parser_sees_the_execute_plan_sections():
+    goal, result, feedback = parse_interface(
+        os.path.join(INTERFACES, 'action', 'ExecutePlan.action'))
+    assert ('uint64', 'plan_id', None) in goal
+    assert ('uint16', 'UNSAFE_PLAN', '4') in result
+    assert ('string[]', 'stale_robots', None) in feedback
 
 
 def test_parser_sees_the_plan_sequence_definition():

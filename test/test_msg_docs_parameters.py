@@ -1,9 +1,12 @@
-"""msg_docs/parameters.md lists every parameter with its type, default and range."""
+"""msg_docs lists every parameter of every node with its type, default and range."""
 
 import os
 
 from conftest import REPO_ROOT
+from punctured_planner import executor_node
+from punctured_planner import fleet_sim_node
 from punctured_planner.parameters import PARAMETERS
+import pytest
 
 KINDS = {'string': 'string', 'integer': 'integer', 'double': 'double',
          'string_array': 'string array', 'double_array': 'double array'}
@@ -26,3 +29,13 @@ def test_every_parameter_row_matches_the_declaration():
     with open(os.path.join(REPO_ROOT, 'msg_docs', 'parameters.md'), encoding='utf-8') as f:
         rows = [line for line in f.read().splitlines() if line.startswith('| `')]
     assert rows == [expected_row(spec) for spec in PARAMETERS]
+
+
+@pytest.mark.parametrize('node', [executor_node, fleet_sim_node], ids=lambda m: m.NODE_NAME)
+def test_node_page_parameter_rows_match_the_declarations(node):
+    """The '## Parameters' table of msg_docs/<node>.md, row for row."""
+    with open(os.path.join(REPO_ROOT, 'msg_docs', node.NODE_NAME + '.md'),
+              encoding='utf-8') as f:
+        section = f.read().split('## Parameters', 1)[1].split('\n## ', 1)[0]
+    rows = [line for line in section.splitlines() if line.startswith('| `')]
+    assert rows == [expected_row(spec) for spec in node.PARAMETERS]

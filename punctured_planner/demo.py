@@ -1,0 +1,206 @@
+"""
+``make demo``: a simulated fleet, the planner and the executor, from plan to motion.
+
+1. starts ``fleet_sim``, ``planner_node`` and ``plan_executor`` (processes, one
+   parameter file: config/demo.yaml) in the namespace ``/demo``;
+2. plans from the robots' current state through config/demo_request.yaml
+   (``use_current_state``);
+3. executes the plan through the ExecutePlan action;
+4. prints the executed duration and the simulator's true smallest gap;
+5. writes ``demo.mcap`` (the plan, every reference pose and odometry message,
+   at their arrival times) and ``demo.gif`` (the executed motion, top view).
+
+Ctrl-C stops everything cleanly. Exit 0 when the plan was executed, 1 otherwise.
+"""
+
+import argparse
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+import yaml
+
+from .cli import spin_until
+
+CONFIG = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), 'config')
+NODES = ('fleet_sim', 'planner_node', 'plan_executor')
+
+
+class Recorder:
+    """A client node that records what the demo needs, with arrival times."""
+
+    def __init__(self, names):
+        """Create the node, its executor and subscriptions (in /demo)."""
+        import rclpy
+        from geometry_msgs.msg import PoseStamped
+        from nav_msgs.msg import Odometry
+        from punctured_planner_interfaces.msg import Plan
+        from rclpy.executors import SingleThreadedExecutor
+        from std_msgs.msg import Float64
+
+        from .planner_node import LATCHED
+        rclpy.init(args=[])
+        self.node = rclpy.create_node('demo', namespace='/demo')
+        self.executor = SingleThreadedExecutor()
+        self.executor.add_node(self.node)
+        self.names = names
+        self.messages = []   # (topic, message, arrival ns)
+        self.gap = []
+        self.odometry = {}
+
+        def keep(topic):
+            return lambda msg: self.messages.append(
+                (topic, msg, self.node.get_clock().now().nanoseconds))
+
+        self.node.create_subscription(Plan, 'plan', keep('/demo/plan'), LATCHED)
+        for name in names:
+            self.node.create_subscription(PoseStamped, name + '/reference_pose',
+                                          keep('/demo/%s/reference_pose' % name), 50)
+            self.node.create_subscription(Odometry, name + '/odom',
+                                          self._odometry(name, keep('/demo/%s/odom' % name)),
+                                          50)
+        self.node.create_subscription(Float64, 'fleet_sim/min_gap',
+                                      lambda msg: self.gap.append(msg.data), LATCHED)
+
+    def _odometry(self, name, keep):
+        def callback(msg):
+            self.odometry[name] = msg
+            keep(msg)
+        return callback
+
+    def spin(self, predicate, timeout_sec):
+        """Spin until predicate() or the timeout; return whether it became true."""
+        return spin_until(self.executor, predicate, timeout_sec)
+
+    def close(self):
+        """Destroy the node and shut rclpy down."""
+        import rclpy
+        self.executor.shutdown()
+        self.node.destroy_node()
+        rclpy.try_shutdown()
+
+
+def _run(recorder, request_path, mcap_path, gif_path):
+    """Plan and execute; write the recording and the GIF; return the exit code."""
+    from punctured_planner_interfaces.action import ExecutePlan
+    from punctured_planner_interfaces.srv import PlanSequence
+    from rclpy.action import ActionClient
+
+    from .cli import call_service
+    from .msg_dict import fill_message
+    node = recorder.node
+    client = node.create_client(PlanSequence, 'plan_sequence')
+    action = ActionClient(node, ExecutePlan, 'execute_plan')
+    if not (client.wait_for_service(timeout_sec=30) and action.wait_for_server(timeout_sec=30)
+            and recorder.spin(lambda: len(recorder.odometry) == len(recorder.names), 30)):
+        print('demo: the nodes did not come up', file=sys.stderr)
+        return 1
+    with open(request_path, encoding='utf-8') as stream:
+        request = fill_message(PlanSequence.Request(), yaml.safe_load(stream))
+    response = call_service(recorder.executor, client, request, 30)
+    deadline = time.monotonic() + 10
+    while (response is not None and response.error_code == PlanSequence.Response.NO_ROBOT_STATE
+           and time.monotonic() < deadline):
+        # the planner's own odometry subscriptions may match a little later than ours
+        recorder.spin(lambda: False, 0.2)
+        response = call_service(recorder.executor, client, request, 30)
+    if response is None or response.error_code != 0:
+        print('demo: planning failed: %s' % (response.error_msg if response else 'no answer'),
+              file=sys.stderr)
+        return 1
+    planned = response.duration.sec + response.duration.nanosec * 1e-9
+    print('planned plan %d: %d robots, %.2f s at %.2f m/s, min gap %.3f m, tolerance %.3f m'
+          % (response.plan_id, len(response.paths), planned, request.max_speed,
+             2 * response.tracking_tolerance, response.tracking_tolerance))
+    goal = action.send_goal_async(ExecutePlan.Goal(plan_id=response.plan_id))
+    recorder.spin(goal.done, 10)
+    result_future = goal.result().get_result_async()
+    recorder.spin(result_future.done, 600)
+    result = result_future.result().result
+    recorder.spin(lambda: False, 0.3)
+    executed = result.executed_duration.sec + result.executed_duration.nanosec * 1e-9
+    gap = recorder.gap[-1] if recorder.gap else float('nan')
+    print('executed: %s in %.2f s (plan %.2f s); true smallest gap %.4f m; largest tracking '
+          'error %.3f m' % (result.error_msg or result.error_code, executed, planned, gap,
+                            max(result.max_tracking_errors, default=0.0)))
+    _write(recorder, response, mcap_path, gif_path)
+    return 0 if result.error_code == 0 else 1
+
+
+def _write(recorder, response, mcap_path, gif_path):
+    """Write demo.mcap and demo.gif from the recorded messages."""
+    from . import conversions
+    from .recording import write_mcap
+    from .viz.motion import render_motion
+    messages = recorder.messages
+    write_mcap(mcap_path, [(t, m) for t, m, _ in messages], [ns for _, _, ns in messages],
+               {'plan_id': response.plan_id})
+    odometry = [(ns, m) for t, m, ns in messages if t.endswith('/odom')]
+    index = {name: i for i, name in enumerate(recorder.names)}
+    start = odometry[0][0]
+    frames, times, current = [], [], None
+    for ns, msg in odometry:
+        name = msg.child_frame_id.split('/')[0]
+        if current is None:
+            current = np.full((len(index), 2), np.nan)
+        current[index[name]] = conversions.odometry_pose(msg)[0][:2]
+        if not np.isnan(current).any():
+            frames.append(current.copy())
+            times.append((ns - start) * 1e-9)
+    positions = np.array(frames)
+    plan = next(m for t, m, _ in messages if t == '/demo/plan')
+    planned = np.stack([conversions.path_arrays(p)[1][:, :2] for p in plan.paths], axis=1)
+    obstacles = np.array([(p.x, p.y) for p in plan.obstacles]).reshape(-1, 2)
+    from .execution import Bodies
+    bodies = Bodies(0.1, np.c_[obstacles, np.zeros(len(obstacles))], np.zeros(len(obstacles)))
+    gaps = np.minimum.accumulate([bodies.smallest_gap(np.c_[p, np.zeros(len(p))]).value
+                                  for p in positions])
+    render_motion(gif_path, np.array(times), positions, planned, obstacles, 0.1, gaps,
+                  title='make demo: plan %d executed' % plan.plan_id)
+    print('wrote %s (%d messages) and %s' % (mcap_path, len(messages), gif_path))
+
+
+def main(argv=None):
+    """Run the demo; return 0 when the plan was executed."""
+    parser = argparse.ArgumentParser(description='From plan to motion with a simulated fleet.')
+    parser.add_argument('--params', default=os.path.join(CONFIG, 'demo.yaml'))
+    parser.add_argument('--request', default=os.path.join(CONFIG, 'demo_request.yaml'))
+    parser.add_argument('--mcap', default='demo.mcap')
+    parser.add_argument('--gif', default='demo.gif')
+    args = parser.parse_args(argv)
+    os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
+    with open(args.params, encoding='utf-8') as stream:
+        names = yaml.safe_load(stream)['/**']['ros__parameters']['robot_names']
+    logs = tempfile.mkdtemp(prefix='punctured_planner_demo_')
+    bin_dir = os.path.dirname(sys.executable)
+    processes = [subprocess.Popen(
+        [os.path.join(bin_dir, name), '--ros-args', '-r', '__ns:=/demo', '--params-file',
+         args.params], stdout=open(os.path.join(logs, name + '.log'), 'wb'),
+        stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL) for name in NODES]
+    print('started %s (logs in %s)' % (', '.join(NODES), logs))
+    recorder = None
+    code = 1
+    try:
+        recorder = Recorder(names)
+        code = _run(recorder, args.request, args.mcap, args.gif)
+    except KeyboardInterrupt:
+        print('demo: interrupted')
+    finally:
+        if recorder is not None:
+            recorder.close()
+        for process in processes:
+            process.send_signal(signal.SIGINT)
+        for name, process in zip(NODES, processes):
+            try:
+                process.wait(timeout=15)
+            except subprocess.TimeoutExpired:
+                process.kill()
+    return code
+
+
+if __name__ == '__main__':
+    sys.exit(main())

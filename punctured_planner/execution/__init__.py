@@ -1,0 +1,21 @@
+"""
+Executing a plan in lockstep, ROS-free: the shared plan clock and the tracking law.
+
+A plan is collision-free only when every robot is at its reference at the same
+instant (msg_docs/ExecutePlan.md). ``tolerance`` gives the deviation each
+robot may have while the bodies still cannot touch, ``reference`` the robots'
+reference positions and velocities at a plan time, ``bodies`` the surface gaps
+of disc robots and obstacles, and ``execution`` one control step: advance the
+shared clock as far as the robots' errors allow, then track the reference with
+feed-forward and saturated feedback. The ``plan_executor`` node is a thin
+adapter around :class:`Execution`; the simulated fleet (``sim``) uses
+``bodies`` for its true gap.
+"""
+
+from .bodies import Bodies, Gap
+from .execution import Execution, ExecutionSettings, Step
+from .reference import Reference
+from .tolerance import clock_rate, tracking_tolerance
+
+__all__ = ['Bodies', 'Execution', 'ExecutionSettings', 'Gap', 'Reference', 'Step',
+           'clock_rate', 'tracking_tolerance']

@@ -1,0 +1,75 @@
+"""
+Surface gaps between disc robots and disc obstacles, exact over straight moves.
+
+A robot is a disc (a ball in 3-D) of radius R around its centre, obstacle j a
+disc of radius rho_j. Their surface gap is centre distance - 2R for two robots
+and centre distance - R - rho_j for a robot and an obstacle; negative means
+contact (msg_docs/Plan.md). Over a step in which every robot moves on
+a straight line at constant speed the relative position of a pair is linear
+in time, so its smallest distance has the closed form of the clearance
+certificate (:func:`punctured_planner.core.certificate.segment_minimum`).
+"""
+
+from dataclasses import dataclass
+from dataclasses import field
+
+import numpy as np
+
+from ..core.certificate import segment_minimum
+from ..core.pairs import point_pairs
+
+
+@dataclass(frozen=True)
+class Gap:
+    """A surface gap (m) and where it is: kind 'robots' (a, b) or 'obstacle' (robot, obstacle)."""
+
+    value: float
+    kind: str = 'none'
+    first: int = -1
+    second: int = -1
+
+    def describe(self, names) -> str:
+        """Return 'robot_1 and robot_4' or 'robot_1 and obstacle 2' for robot names."""
+        if self.kind == 'robots':
+            return '%s and %s' % (names[self.first], names[self.second])
+        return '%s and obstacle %d' % (names[self.first], self.second)
+
+
+@dataclass(frozen=True)
+class Bodies:
+    """The bodies' sizes: robot radius R, obstacle centres (r, 3) and radii (r,)."""
+
+    robot_radius: float = 0.0
+    obstacles: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    obstacle_radii: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+    def pair_gaps(self, start: np.ndarray, end: np.ndarray = None) -> tuple:
+        """
+        Return (gaps, a, b): every pair's smallest surface gap while moving start -> end.
+
+        start and end are (k, 3) centres (end None: the gaps at start). The pairs
+        are core.pairs.point_pairs(k, r): robot pairs, then (robot, k + obstacle).
+        """
+        k, r = len(start), len(self.obstacles)
+        a, b = point_pairs(k, r)
+        points = np.concatenate([start, self.obstacles])
+        relative = points[a] - points[b]
+        if end is None:
+            squared = np.einsum('ij,ij->i', relative, relative)
+        else:
+            moved = np.concatenate([end, self.obstacles])
+            squared, _ = segment_minimum(relative, moved[a] - moved[b] - relative)
+        radii = np.concatenate([np.full(k, float(self.robot_radius)),
+                                np.asarray(self.obstacle_radii, dtype=float)])
+        return np.sqrt(squared) - radii[a] - radii[b], a, b
+
+    def smallest_gap(self, start: np.ndarray, end: np.ndarray = None) -> Gap:
+        """Return the smallest surface Gap while moving start -> end (inf: nothing to meet)."""
+        gaps, a, b = self.pair_gaps(start, end)
+        if gaps.size == 0:
+            return Gap(np.inf)
+        i = int(np.argmin(gaps))
+        k = len(start)
+        if b[i] >= k:
+            return Gap(float(gaps[i]), 'obstacle', int(a[i]), int(b[i]) - k)
+        return Gap(float(gaps[i]), 'robots', int(a[i]), int(b[i]))

@@ -1,0 +1,230 @@
+"""
+The execution and simulation logic without DDS: tolerance, clock, reference, gaps, fleet.
+
+The closed loop at the end runs the real Execution against the real Fleet on a
+certified plan of the core, with a slow robot, a late robot and noise.
+"""
+
+from hypothesis import given
+from hypothesis import settings
+from hypothesis import strategies as st
+import numpy as np
+from punctured_planner.core import plan
+from punctured_planner.core import Workspace
+from punctured_planner.execution import Bodies
+from punctured_planner.execution import clock_rate
+from punctured_planner.execution import Execution
+from punctured_planner.execution import ExecutionSettings
+from punctured_planner.execution import Reference
+from punctured_planner.execution import tracking_tolerance
+from punctured_planner.execution.execution import saturate
+from punctured_planner.sim import Fleet
+from punctured_planner.sim import FleetSettings
+import pytest
+
+IDENTITY = (0.0, 0.0, 0.0, 1.0)
+
+
+def reference_of(seconds, positions):
+    """Return a Reference with identity orientations."""
+    positions = np.asarray(positions, dtype=float)
+    return Reference(np.asarray(seconds, dtype=float), positions,
+                     np.tile(IDENTITY, positions.shape[:2] + (1,)))
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2 ** 32 - 1), st.integers(2, 8), st.integers(0, 3))
+def test_within_the_tolerance_bodies_never_touch(seed, k, r):
+    """Every robot within delta = min_gap / 2 of its reference: every gap stays >= 0."""
+    rng = np.random.default_rng(seed)
+    radius = rng.uniform(0.0, 0.3)
+    obstacles = rng.uniform(-3, 3, (r, 3))
+    bodies = Bodies(radius, obstacles, rng.uniform(0.0, 0.3, r))
+    reference = rng.uniform(-3, 3, (k, 3))
+    gap = bodies.smallest_gap(reference).value
+    if not gap > 0:
+        return
+    delta = tracking_tolerance(gap)
+    directions = rng.normal(size=(k, 3))
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    # worst case: each robot as far as allowed, some straight at their nearest neighbour
+    moved = reference + delta * rng.uniform(0.0, 1.0, (k, 1)) * directions
+    assert bodies.smallest_gap(moved).value >= gap - 2 * delta - 1e-12 >= -1e-12
+    toward = reference.copy()
+    toward[0] += delta * (reference[1] - reference[0]) / np.linalg.norm(
+        reference[1] - reference[0])
+    toward[1] -= delta * (reference[1] - reference[0]) / np.linalg.norm(
+        reference[1] - reference[0])
+    assert bodies.smallest_gap(toward).value >= -1e-12
+
+
+def test_clock_rate_runs_slows_and_holds():
+    assert clock_rate(np.array([0.0, 0.05]), 0.2, 0.5, 0.9) == 1.0
+    assert clock_rate(np.array([0.14]), 0.2, 0.5, 0.9) == pytest.approx(0.5)
+    assert clock_rate(np.array([0.01, 0.19]), 0.2, 0.5, 0.9) == 0.0
+    assert clock_rate(np.array([5.0]), np.inf, 0.5, 0.9) == 1.0
+    assert clock_rate(np.zeros(0), 0.2, 0.5, 0.9) == 1.0
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.lists(st.floats(0.0, 1.0), min_size=2, max_size=6))
+def test_clock_rate_is_monotone_and_bounded(errors):
+    rates = [clock_rate(np.array([e]), 1.0, 0.3, 0.8) for e in sorted(errors)]
+    assert all(0.0 <= rate <= 1.0 for rate in rates)
+    assert all(a >= b for a, b in zip(rates, rates[1:]))
+
+
+def test_reference_interpolates_the_breakpoints_and_skips_repeated_stamps():
+    positions = [[[0, 0, 0]], [[1, 0, 0]], [[1, 0, 0]], [[1, 2, 0]]]
+    reference = reference_of([0.0, 1.0, 1.0, 3.0], positions)
+    assert reference.duration == 3.0
+    for s, expected in ((0.0, [0, 0, 0]), (0.5, [0.5, 0, 0]), (1.0, [1, 0, 0]),
+                        (2.0, [1, 1, 0]), (3.0, [1, 2, 0]), (9.0, [1, 2, 0])):
+        assert np.allclose(reference.position(s), [expected]), s
+    assert np.allclose(reference.velocity(0.5), [[1, 0, 0]])
+    assert np.allclose(reference.velocity(1.0), [[0, 1, 0]])
+    assert np.allclose(reference.velocity(3.0), [[0, 0, 0]])
+
+
+def test_saturation_keeps_direction_and_limit():
+    velocities = np.array([[3.0, 4.0, 0.0], [0.1, 0.0, 0.0], [0.0, 0.0, 0.0]])
+    result = saturate(velocities, 1.0)
+    assert np.allclose(result, [[0.6, 0.8, 0.0], [0.1, 0.0, 0.0], [0.0, 0.0, 0.0]])
+
+
+def test_gap_is_exact_over_a_step_even_when_robots_pass_through_each_other():
+    bodies = Bodies(0.1)
+    start = np.array([[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    end = np.array([[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0]])
+    assert bodies.smallest_gap(start).value == pytest.approx(1.8)
+    assert bodies.smallest_gap(end).value == pytest.approx(1.8)
+    gap = bodies.smallest_gap(start, end)
+    assert gap.value == pytest.approx(-0.2) and (gap.kind, gap.first, gap.second) == (
+        'robots', 0, 1)
+    pillar = Bodies(0.1, np.array([[0.0, 0.5, 0.0]]), np.array([0.2]))
+    gap = pillar.smallest_gap(start[:1], end[:1])
+    assert gap.kind == 'obstacle' and gap.value == pytest.approx(0.2)
+
+
+def test_stale_odometry_holds_the_clock_and_it_resumes():
+    reference = reference_of([0.0, 10.0], [[[0, 0, 0], [5, 0, 0]], [[10, 0, 0], [5, 10, 0]]])
+    execution = Execution(reference, 0.5, ExecutionSettings(speed_limit=2.0))
+    positions = reference.position(0.0).copy()
+    step = execution.step(0.1, positions, [False, False])
+    assert step.rate == 1.0 and step.plan_time == pytest.approx(0.1)
+    step = execution.step(0.1, positions, [False, True])
+    assert step.rate == 0.0 and step.plan_time == pytest.approx(0.1)
+    assert np.allclose(step.velocities[1], 0.0), 'a stale robot is sent zero velocity'
+    assert np.linalg.norm(step.velocities[0]) > 0, 'the others track the held reference'
+    step = execution.step(0.1, reference.position(0.1), [False, False])
+    assert step.rate == 1.0 and step.plan_time == pytest.approx(0.2)
+
+
+def certified_fleet(k=6, seed=2):
+    """Return (plan reference, Bodies, min gap): k robots crossing a row of pillars."""
+    rng = np.random.default_rng(seed)
+    obstacles = np.array([[-2.0, 0.4], [0.2, -0.3], [2.5, 0.2]])
+    start = np.c_[np.linspace(-3, 3, k) + rng.uniform(-0.2, 0.2, k), np.full(k, 2.5)]
+    goal = np.c_[np.linspace(3, -3, k), np.full(k, -2.5)]
+    core = plan(Workspace(obstacles, variant='spread', min_spacing=0.6, lane_spacing=0.6),
+                np.stack([start, goal]))
+    positions = np.concatenate([core.positions, np.zeros(core.positions.shape[:2] + (1,))],
+                               axis=-1)
+    radius = 0.1
+    bodies = Bodies(radius, np.c_[obstacles, np.zeros(3)], np.zeros(3))
+    return reference_of(core.stamps(0.5), positions), bodies, core.min_clearance - 2 * radius
+
+
+def closed_loop(reference, bodies, gap, shared_clock, slow=0, late=1, limit=400.0):
+    """Run Execution at 20 Hz against a Fleet at 40 Hz; return (fleet, execution, seconds)."""
+    k = reference.robot_count
+    fleet = Fleet(reference.position(0.0), FleetSettings(
+        bodies=bodies, speed_limit=0.5,
+        speed_factors=np.where(np.arange(k) == slow, 0.5, 1.0),
+        latencies=np.where(np.arange(k) == late, 0.2, 0.0), velocity_noise=0.05, seed=3))
+    execution = Execution(reference, tracking_tolerance(gap),
+                          ExecutionSettings(speed_limit=0.5, shared_clock=shared_clock),
+                          bodies)
+    now = 0.0
+    while now < limit:
+        step = execution.step(0.05, fleet.positions, np.zeros(k, dtype=bool))
+        for robot in range(k):
+            fleet.command(robot, step.velocities[robot], now)
+        for _ in range(2):
+            fleet.step(now, 0.025)
+            now += 0.025
+        if step.finished:
+            break
+    return fleet, execution, now
+
+
+def test_closed_loop_with_a_slow_and_a_late_robot_keeps_bodies_apart():
+    reference, bodies, gap = certified_fleet()
+    assert gap > 0
+    fleet, execution, seconds = closed_loop(reference, bodies, gap, shared_clock=True)
+    assert fleet.min_gap >= 0
+    assert execution.max_errors.max() <= tracking_tolerance(gap)
+    assert np.linalg.norm(fleet.positions - reference.positions[-1], axis=1).max() <= 0.02
+    # the slow robot needs twice the plan's time where it is the fastest mover
+    assert reference.duration < seconds <= 1.5 * 2 * reference.duration
+
+
+def test_without_the_shared_clock_the_slow_robot_falls_behind():
+    reference, bodies, gap = certified_fleet()
+    _, execution, _ = closed_loop(reference, bodies, gap, shared_clock=False)
+    assert execution.max_errors.max() > 2 * tracking_tolerance(gap)
+
+
+def test_fleet_latency_speed_factor_and_command_timeout():
+    fleet = Fleet(np.zeros((2, 3)), FleetSettings(
+        speed_limit=1.0, speed_factors=np.array([0.5, 1.0]), latencies=np.array([0.0, 0.2]),
+        command_timeout=0.3))
+    for robot in range(2):
+        fleet.command(robot, [2.0, 0.0, 0.0], 0.0)
+    fleet.step(0.0, 0.1)
+    assert np.allclose(fleet.positions[:, 0], [0.05, 0.0]), 'saturated, halved; not yet'
+    fleet.step(0.2, 0.1)
+    assert np.allclose(fleet.positions[:, 0], [0.1, 0.1])
+    fleet.step(0.45, 0.1)
+    assert np.allclose(fleet.velocities[0], 0.0), 'no command for 0.45 s: stopped'
+    assert np.allclose(fleet.velocities[1], [1.0, 0.0, 0.0])
+
+
+def test_fleet_reports_each_contact_once():
+    fleet = Fleet(np.array([[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]]),
+                  FleetSettings(bodies=Bodies(0.2), speed_limit=1.0))
+    contacts = []
+    for step in range(30):
+        fleet.command(0, [1.0, 0.0, 0.0], step * 0.1)
+        contacts += fleet.step(step * 0.1, 0.1)
+    assert len(contacts) == 1
+    assert (contacts[0].kind, contacts[0].first, contacts[0].second) == ('robots', 0, 1)
+    assert fleet.min_gap == pytest.approx(-0.4)
+
+
+def test_plan_message_round_trip_to_the_executor_reference():
+    """The published Plan carries the motion, the bodies and delta = min_gap / 2."""
+    from planner_helpers import make_request
+    from punctured_planner import conversions
+    from punctured_planner.cli import offline_plan
+    from punctured_planner.parameters import settings_from_values
+    settings = settings_from_values({'obstacles': [-2.0, 0.5, 0.0, 0.0, -0.5, 0.0,
+                                                   2.5, 0.0, 0.0]})
+    outcome = offline_plan(make_request(max_speed=0.5), settings, now_ns=10 ** 18)
+    assert outcome.ok
+    outcome.plan_id = 3
+    message = conversions.plan_message(outcome, settings)
+    assert message.plan_id == 3 and message.robot_names == [f'robot_{i}' for i in range(4)]
+    assert message.tracking_tolerance == outcome.plan.min_gap / 2 == \
+        outcome.response.tracking_tolerance
+    reference = conversions.plan_reference(message)
+    samples = outcome.plan.sample(0, 0.5)
+    assert np.array_equal(reference.positions[:, :, :2], samples.positions)
+    assert np.allclose(reference.seconds, samples.values, atol=1e-8)
+    bodies = conversions.plan_bodies(message)
+    assert bodies.obstacles.shape == (3, 3) and bodies.obstacle_radii.tolist() == [0.0] * 3
+    # the paths share their Header objects: give one pose a header of its own
+    from std_msgs.msg import Header
+    message.paths[1].poses[2].header = Header(frame_id='map', stamp=conversions.time_from_ns(1))
+    with pytest.raises(ValueError, match='robot_1'):
+        conversions.plan_reference(message)

@@ -1,0 +1,240 @@
+"""
+Closed loop over real DDS: planner_node, fleet_sim and plan_executor as processes.
+
+Three disc robots, one at half speed, one with 100 ms command latency, 5%
+velocity noise. One run checks the refusals (no plan, a robot not heard,
+odometry in another frame), a full execution with a stale robot in the middle
+(the clock holds, then resumes), the true gap, the arrival, a cancel, and
+Ctrl-C of the executor in the middle of a goal (exit 0, no traceback, robots
+stopped, the simulator serving on). The figures for 20 robots are in bench/.
+"""
+
+import signal
+import time
+
+from conftest import NodeProcess
+from conftest import venv_script
+import numpy as np
+import pytest
+
+pytestmark = [pytest.mark.ros, pytest.mark.slow]
+
+NAMES = ['r0', 'r1', 'r2']
+START = [[-1.5, -1.2, 0.0], [0.0, -1.4, 0.0], [1.5, -1.2, 0.0]]
+GOAL = [[-1.5, 1.2, 0.0], [0.0, 1.4, 0.0], [1.5, 1.2, 0.0]]
+OBSTACLES = [-1.0, 0.3, 0.0, 0.1, -0.3, 0.0, 1.2, 0.0, 0.0]
+RADIUS = 0.1
+PARAMETERS = """
+/**:
+  ros__parameters:
+    frame_id: map
+    robot_names: [r0, r1, r2]
+    obstacles: %(obstacles)s
+/**/planner_node:
+  ros__parameters:
+    min_spacing: 0.5
+    lane_spacing: 0.5
+    max_speed: 1.0
+/**/fleet_sim:
+  ros__parameters:
+    initial_positions: %(start)s
+    robot_radius: %(radius)s
+    speed_limit: 1.0
+    speed_factors: [0.5, 1.0, 1.0]
+    latencies: [0.0, 0.1, 0.0]
+    velocity_noise: 0.05
+/**/plan_executor:
+  ros__parameters:
+    speed_limit: 1.0
+    discovery_timeout: 1.0
+""" % {'obstacles': OBSTACLES, 'start': [v for p in START for v in p], 'radius': RADIUS}
+
+
+class Graph:
+    """The three processes and the test's client: action, service, parameters, topics."""
+
+    def __init__(self, client, env, tmp_path, namespace):
+        """Start the nodes in one namespace and connect the client to them."""
+        from geometry_msgs.msg import Twist
+        from nav_msgs.msg import Odometry
+        from punctured_planner.planner_node import LATCHED
+        from punctured_planner_interfaces.action import ExecutePlan
+        from punctured_planner_interfaces.srv import PlanSequence
+        from rclpy.action import ActionClient
+        from rclpy.parameter_client import AsyncParameterClient
+        from std_msgs.msg import Float64
+        params = tmp_path / 'execution.yaml'
+        params.write_text(PARAMETERS, encoding='utf-8')
+        self.client = client
+        self.namespace = namespace
+        self.processes = {
+            name: NodeProcess([venv_script(name), '--ros-args', '-r', '__ns:=' + namespace,
+                               '--params-file', str(params)], env,
+                              str(tmp_path / (name + '.log')), namespace)
+            for name in ('planner_node', 'fleet_sim', 'plan_executor')}
+        node = client.node
+        self.plan_sequence = node.create_client(PlanSequence, self.name('plan_sequence'))
+        self.action = ActionClient(node, ExecutePlan, self.name('execute_plan'))
+        self.sim_parameters = AsyncParameterClient(node, self.name('fleet_sim'))
+        self.odometry = {}
+        self.commands = {name: [] for name in NAMES}
+        for name in NAMES:
+            node.create_subscription(Odometry, self.name(name + '/odom'),
+                                     lambda msg, name=name: self.odometry.__setitem__(
+                                         name, msg), 10)
+            node.create_subscription(Twist, self.name(name + '/cmd_vel'),
+                                     lambda msg, name=name: self.commands[name].append(
+                                         (time.monotonic(), msg)), 10)
+        self.gap = []
+        node.create_subscription(Float64, self.name('fleet_sim/min_gap'),
+                                 lambda msg: self.gap.append(msg.data), LATCHED)
+        client.wait_for_service(self.plan_sequence, 30)
+        assert self.action.wait_for_server(timeout_sec=30), self.logs()
+        assert self.sim_parameters.wait_for_services(timeout_sec=30), self.logs()
+        assert client.spin_until(lambda: len(self.odometry) == len(NAMES), 30), self.logs()
+
+    def name(self, relative):
+        """Return the absolute name of a relative topic, service, action or node."""
+        return '%s/%s' % (self.namespace, relative)
+
+    def logs(self):
+        """Return every process's output, for failure messages."""
+        return '\n'.join('--- %s\n%s' % (n, p.log()) for n, p in self.processes.items())
+
+    def plan(self, configurations):
+        """Plan from the robots' current state; return the response."""
+        from punctured_planner_interfaces.srv import PlanSequence
+        from planner_helpers import pose_array
+        request = PlanSequence.Request(use_current_state=True)
+        request.configurations = [pose_array(c) for c in configurations]
+        response = self.client.call(self.plan_sequence, request)
+        assert response.error_code == 0, response.error_msg + self.logs()
+        return response
+
+    def set_sim(self, **values):
+        """Set fleet_sim parameters; fail unless every one is accepted."""
+        from rclpy.parameter import Parameter
+        future = self.sim_parameters.set_parameters(
+            [Parameter(name, value=value) for name, value in values.items()])
+        assert self.client.spin_until(future.done, 10)
+        assert all(r.successful for r in future.result().results), future.result()
+
+    def send(self, plan_id=0):
+        """Send a goal; return (goal handle, feedback list)."""
+        from punctured_planner_interfaces.action import ExecutePlan
+        feedback = []
+        future = self.action.send_goal_async(
+            ExecutePlan.Goal(plan_id=plan_id),
+            feedback_callback=lambda msg: feedback.append((time.monotonic(), msg.feedback)))
+        assert self.client.spin_until(future.done, 10)
+        handle = future.result()
+        assert handle.accepted
+        return handle, feedback
+
+    def result(self, handle, timeout_sec=60):
+        """Wait for a goal's result message."""
+        future = handle.get_result_async()
+        assert self.client.spin_until(future.done, timeout_sec), self.logs()
+        return future.result().result
+
+    def positions(self):
+        """Return where the robots are now, by their latest odometry: (k, 3)."""
+        return np.array([[o.pose.pose.position.x, o.pose.pose.position.y,
+                          o.pose.pose.position.z] for o in
+                         (self.odometry[name] for name in NAMES)])
+
+    def speeds(self):
+        """Return how fast the robots move now, by their latest odometry: (k,)."""
+        return np.array([np.hypot(o.twist.twist.linear.x, o.twist.twist.linear.y)
+                         for o in (self.odometry[name] for name in NAMES)])
+
+
+@pytest.fixture
+def graph(ros_client, ros_env, tmp_path):
+    """Start the graph; stop every process after the test."""
+    import os
+    started = Graph(ros_client, ros_env, tmp_path, '/pp_exec_%d' % os.getpid())
+    yield started
+    for process in started.processes.values():
+        process.stop()
+
+
+def test_plan_to_motion_over_dds(graph):
+    from punctured_planner_interfaces.action import ExecutePlan
+    result_type = ExecutePlan.Result
+    client = graph.client
+
+    # refused: no plan yet, then a plan id that is not there
+    result = graph.result(graph.send(0)[0])
+    assert result.error_code == result_type.NO_PLAN and 'no plan' in result.error_msg
+
+    response = graph.plan([GOAL])
+    assert response.plan_id == 1
+    assert response.tracking_tolerance == pytest.approx(response.min_clearance / 2)
+    result = graph.result(graph.send(7)[0])
+    assert result.error_code == result_type.NO_PLAN and 'plan 7' in result.error_msg
+
+    # refused: a robot it does not hear from, then odometry in another frame
+    graph.set_sim(muted_robots=['r2'])
+    time.sleep(0.6)
+    result = graph.result(graph.send(1)[0])
+    assert result.error_code == result_type.UNKNOWN_ROBOTS, result.error_msg
+    assert 'r2' in result.error_msg and 'r0' not in result.error_msg
+    graph.set_sim(muted_robots=[], frame_id='odom')
+    result = graph.result(graph.send(1)[0])
+    assert result.error_code == result_type.FRAME_MISMATCH, result.error_msg
+    assert "'odom'" in result.error_msg and "'map'" in result.error_msg
+    graph.set_sim(frame_id='map')
+    time.sleep(0.3)
+
+    # executed, with r2's odometry gone for a while in the middle
+    handle, feedback = graph.send(1)
+    assert client.spin_until(lambda: feedback and feedback[-1][1].plan_time > 1.0, 20)
+    graph.set_sim(muted_robots=['r2'])
+    assert client.spin_until(lambda: feedback[-1][1].stale_robots == ['r2'], 5), graph.logs()
+    held = feedback[-1][1].plan_time
+    client.spin_until(lambda: False, 1.0)
+    assert feedback[-1][1].plan_time == held and feedback[-1][1].clock_rate == 0.0
+    graph.set_sim(muted_robots=[])
+    assert client.spin_until(lambda: feedback[-1][1].plan_time > held + 0.5, 10)
+    result = graph.result(handle)
+    assert result.error_code == result_type.NONE, result.error_msg + graph.logs()
+    executed = result.executed_duration.sec + result.executed_duration.nanosec * 1e-9
+    planned = response.duration.sec + response.duration.nanosec * 1e-9
+    assert planned < executed < 2 * 1.5 * planned + 3.0
+    assert max(result.max_tracking_errors) <= response.tracking_tolerance
+    assert client.spin_until(lambda: graph.gap, 5)
+    assert graph.gap[-1] >= 0.0, graph.processes['fleet_sim'].log()
+    client.spin_until(lambda: False, 0.3)
+    assert np.linalg.norm(graph.positions() - GOAL, axis=1).max() <= 0.02
+
+    # cancel: every robot is commanded zero at once and stops
+    graph.plan([START])
+    handle, feedback = graph.send(0)
+    assert client.spin_until(lambda: feedback and feedback[-1][1].plan_time > 1.0, 20)
+    assert graph.speeds().max() > 0.1
+    cancel = handle.cancel_goal_async()
+    asked = time.monotonic()
+    assert client.spin_until(cancel.done, 5)
+    result = graph.result(handle)
+    assert result.error_code == result_type.CANCELED
+    client.spin_until(lambda: False, 0.5)
+    for name in NAMES:
+        last = graph.commands[name][-1]
+        assert last[0] - asked < 0.2 and last[1].linear.x == last[1].linear.y == 0.0, name
+    assert graph.speeds().max() < 1e-9
+
+    # Ctrl-C of the executor in the middle of a goal: exit 0, robots stopped
+    graph.plan([GOAL])
+    handle, feedback = graph.send(0)
+    assert client.spin_until(lambda: feedback and feedback[-1][1].plan_time > 0.5, 20)
+    executor = graph.processes['plan_executor']
+    executor.proc.send_signal(signal.SIGINT)
+    assert executor.proc.wait(timeout=10) == 0, executor.log()
+    client.spin_until(lambda: False, 0.5)
+    assert graph.speeds().max() < 1e-9
+    graph.processes['fleet_sim'].assert_running()
+    for name in ('fleet_sim', 'plan_executor'):
+        process = graph.processes[name]
+        assert process.stop() == 0
+        assert 'Traceback' not in process.log(), process.log()
