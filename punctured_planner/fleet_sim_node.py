@@ -174,6 +174,13 @@ class FleetSim(Node):
         self._fleet.command(robot, velocity, self._seconds(self.get_clock().now().nanoseconds))
 
     def _step(self):
+        """One simulation step and its messages (the timer); a bug is logged, not fatal."""
+        try:
+            self._step_and_publish()
+        except Exception as error:  # noqa: B902 - the simulator keeps running
+            self.get_logger().error('step failed: %s: %s' % (type(error).__name__, error))
+
+    def _step_and_publish(self):
         now_ns = self.get_clock().now().nanoseconds
         dt = min((now_ns - self._last_ns) * 1e-9, 5 * self._period)
         self._last_ns = now_ns

@@ -11,7 +11,8 @@ Channels (absolute topic names, as ``ros2 bag`` records them):
 
 * ``/<robot_name>/plan`` nav_msgs/msg/Path, one per robot;
 * ``/plan_markers`` visualization_msgs/msg/MarkerArray;
-* ``/domain_index`` std_msgs/msg/UInt32.
+* ``/domain_index`` std_msgs/msg/UInt32;
+* ``/plan`` punctured_planner_interfaces/msg/Plan (plan_id 0: not published by a node).
 
 Every message is logged at the plan's start stamp. A metadata record
 ``punctured_planner`` carries the plan's figures (domain, clearance, ...).

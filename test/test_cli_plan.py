@@ -85,8 +85,13 @@ def check_recording(path, expected):
         metadata = {m.name: m.metadata for m in make_reader(stream).iter_metadata()}
     topics = [channel.topic for _, channel, _, _ in decoded]
     robots = ['/robot_%d/plan' % i for i in range(expected.positions.shape[1])]
-    assert sorted(topics) == sorted(robots + ['/plan_markers', '/domain_index'])
+    assert sorted(topics) == sorted(robots + ['/plan_markers', '/domain_index', '/plan'])
     for schema, channel, message, ros_msg in decoded:
+        if channel.topic == '/plan':
+            assert schema.name == 'punctured_planner_interfaces/msg/Plan'
+            assert ros_msg.plan_id == 0 and len(ros_msg.paths) == len(robots)
+            assert ros_msg.tracking_tolerance == pytest.approx(expected.min_gap / 2)
+            continue
         assert schema.encoding == 'ros2msg' and channel.message_encoding == 'cdr'
         if channel.topic in robots:
             i = robots.index(channel.topic)

@@ -58,7 +58,10 @@ class Bodies:
             squared = np.einsum('ij,ij->i', relative, relative)
         else:
             moved = np.concatenate([end, self.obstacles])
-            squared, _ = segment_minimum(relative, moved[a] - moved[b] - relative)
+            # segment_minimum takes coordinate-first arrays (d, pairs)
+            squared, _ = segment_minimum(np.ascontiguousarray(relative.T),
+                                         np.ascontiguousarray((moved[a] - moved[b]
+                                                               - relative).T))
         radii = np.concatenate([np.full(k, float(self.robot_radius)),
                                 np.asarray(self.obstacle_radii, dtype=float)])
         return np.sqrt(squared) - radii[a] - radii[b], a, b
