@@ -88,6 +88,10 @@ class Graph:
         self.gap = []
         node.create_subscription(Float64, self.name('fleet_sim/min_gap'),
                                  lambda msg: self.gap.append(msg.data), LATCHED)
+
+    def connect(self):
+        """Wait until every node is discovered and every robot has reported."""
+        client = self.client
         client.wait_for_service(self.plan_sequence, 30)
         assert self.action.wait_for_server(timeout_sec=30), self.logs()
         assert self.sim_parameters.wait_for_services(timeout_sec=30), self.logs()
@@ -154,9 +158,15 @@ def graph(ros_client, ros_env, tmp_path):
     """Start the graph; stop every process after the test."""
     import os
     started = Graph(ros_client, ros_env, tmp_path, '/pp_exec_%d' % os.getpid())
-    yield started
-    for process in started.processes.values():
-        process.stop()
+    try:
+        started.connect()
+        yield started
+    finally:
+        # rclpy does not destroy an ActionClient with its node: a live one left in this
+        # process makes later forked workers (flake8's) crash at exit
+        started.action.destroy()
+        for process in started.processes.values():
+            process.stop()
 
 
 def test_plan_to_motion_over_dds(graph):
