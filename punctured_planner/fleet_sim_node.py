@@ -52,9 +52,10 @@ PARAMETERS = (
     Spec('obstacles', 'double_array', [],
          'Obstacle centres as a flat list x0, y0, z0, ... (for the true gap).',
          constraints='length a multiple of 3, finite values'),
-    Spec('obstacle_radius', 'double', 0.0,
-         'Radius rho of every obstacle (m): a robot-obstacle gap is centre distance - R - '
-         'rho.', low=0.0, high=1e3),
+    Spec('obstacle_radius', 'double_array', [],
+         "Radius rho of the obstacles (m), as planner_node's: empty for 0, one value for "
+         'all, or one per obstacle; a robot-obstacle gap is centre distance - R - rho.',
+         constraints='empty, one value or one per obstacle; finite, >= 0'),
     Spec('speed_limit', 'double', 0.5,
          'Largest speed a robot executes (m/s); faster commands are scaled down.',
          low=0.0, high=1e3),
@@ -109,8 +110,12 @@ def fleet_from_values(values: dict) -> tuple:
     if unknown:
         raise ValueError('muted_robots names %s, not among robot_names' % ', '.join(unknown))
     obstacles = conversions.obstacles_from_parameter(v['obstacles'])
-    bodies = Bodies(v['robot_radius'], obstacles, np.full(len(obstacles),
-                                                          v['obstacle_radius']))
+    radii = np.asarray(v['obstacle_radius'], dtype=float)
+    if radii.size not in (0, 1, len(obstacles)):
+        raise ValueError('obstacle_radius has %d values for %d obstacles (0, 1 or one each)'
+                         % (radii.size, len(obstacles)))
+    bodies = Bodies(v['robot_radius'], obstacles,
+                    np.broadcast_to(radii if radii.size else 0.0, len(obstacles)).copy())
     settings = FleetSettings(
         bodies=bodies, speed_limit=v['speed_limit'],
         speed_factors=_per_robot(v['speed_factors'], 'speed_factors', len(names)),

@@ -38,7 +38,7 @@ def spin_node(factory, name: str, args=None) -> int:
     try:
         try:
             node = factory()
-        except (ValueError, ParameterException) as error:
+        except (ValueError, TypeError, ParameterException) as error:
             print('%s: invalid parameters: %s' % (name, error), file=sys.stderr)
             return 2
         executor.add_node(node)

@@ -32,6 +32,8 @@ PARAMETERS = """
     obstacles: %(obstacles)s
 /**/planner_node:
   ros__parameters:
+    variant: spread
+    robot_radius: %(radius)s
     min_spacing: 0.5
     lane_spacing: 0.5
     max_speed: 1.0
@@ -180,7 +182,8 @@ def test_plan_to_motion_over_dds(graph):
 
     response = graph.plan([GOAL])
     assert response.plan_id == 1
-    assert response.tracking_tolerance == pytest.approx(response.min_clearance / 2)
+    assert response.tracking_tolerance == pytest.approx(response.min_gap / 2)
+    assert 0 < response.min_gap < response.min_clearance  # bodies: the surface gap
     result = graph.result(graph.send(7)[0])
     assert result.error_code == result_type.NO_PLAN and 'plan 7' in result.error_msg
 

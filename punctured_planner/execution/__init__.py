@@ -2,7 +2,7 @@
 Executing a plan in lockstep, ROS-free: the shared plan clock and the tracking law.
 
 A plan is collision-free only when every robot is at its reference at the same
-instant (msg_docs/ExecutePlan.md). ``tolerance`` gives the deviation each
+instant (doc/design.md section 13). ``tolerance`` gives the deviation each
 robot may have while the bodies still cannot touch, ``reference`` the robots'
 reference positions and velocities at a plan time, ``bodies`` the surface gaps
 of disc robots and obstacles, and ``execution`` one control step: advance the

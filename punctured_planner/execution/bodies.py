@@ -4,7 +4,7 @@ Surface gaps between disc robots and disc obstacles, exact over straight moves.
 A robot is a disc (a ball in 3-D) of radius R around its centre, obstacle j a
 disc of radius rho_j. Their surface gap is centre distance - 2R for two robots
 and centre distance - R - rho_j for a robot and an obstacle; negative means
-contact (msg_docs/Plan.md). Over a step in which every robot moves on
+contact (doc/design.md section 13). Over a step in which every robot moves on
 a straight line at constant speed the relative position of a pair is linear
 in time, so its smallest distance has the closed form of the clearance
 certificate (:func:`punctured_planner.core.certificate.segment_minimum`).

@@ -1,7 +1,7 @@
 """
 One control step of a plan's execution: the shared plan clock, then every robot's command.
 
-Each step (msg_docs/ExecutePlan.md, Execution):
+Each step (doc/design.md section 13; msg_docs/ExecutePlan.md):
 
 1. measure every robot's tracking error, |reference(s) - position|, at the
    current plan time s;

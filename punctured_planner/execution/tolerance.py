@@ -1,15 +1,15 @@
 """
 The tracking tolerance of a plan and the rate of the shared plan clock.
 
-Certificate (msg_docs/Plan.md, the tracking tolerance): let g be the plan's
-exact smallest surface gap over the whole motion (centre distance - 2R for two
-robots, centre distance - R - rho for a robot and an obstacle). If at plan
-time s every robot is within delta of its reference position, each centre
-distance differs from the reference one by at most 2 delta (triangle
-inequality; an obstacle does not move, so at most delta there), so every gap
-is at least g - 2 delta. With delta = g / 2 the bodies cannot touch: that
-delta is the tracking tolerance. The shared clock keeps every robot inside it: full speed while the
-largest error is at most ``slow_fraction`` delta, slower in between, held from
+Certificate (doc/design.md section 13): let g be the plan's exact smallest
+surface gap over the whole motion (centre distance - 2R for two robots, centre
+distance - R - rho for a robot and an obstacle). If at plan time s every robot
+is within delta of its reference position, each centre distance differs from
+the reference one by at most 2 delta (triangle inequality; an obstacle does not
+move, so at most delta there), so every gap is at least g - 2 delta. With
+delta = g / 2 the bodies cannot touch: that delta is the tracking tolerance.
+The shared clock keeps every robot inside it: full speed while the largest
+error is at most ``slow_fraction`` delta, slower in between, held from
 ``hold_fraction`` delta on; the margin (1 - hold_fraction) delta covers what a
 robot can move in one control step and its command latency.
 """
