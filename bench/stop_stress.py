@@ -23,13 +23,12 @@ import sys
 import tempfile
 import time
 
-import numpy as np
-
 TEST_DIR = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), 'test')
 sys.path.insert(0, TEST_DIR)
 from colcon_workspace import build_workspace  # noqa: E402 - test/ helpers
 from colcon_workspace import installed_node_command  # noqa: E402
 from colcon_workspace import venv_env  # noqa: E402
+import numpy as np  # noqa: E402
 from stop_check import draw  # noqa: E402
 from stop_check import node_arguments  # noqa: E402
 from stop_check import run_cycle  # noqa: E402

@@ -291,10 +291,10 @@ class PlannerNode(Node):
     def _publish(self, outcome, settings):
         """Publish the complete plan: every robot's Path, stale robots emptied, markers, index."""
         messages = publications.plan_messages(outcome, settings)
-        publishers = [self._publisher(topic, type(message)) for topic, message in messages]
+        publishers = [self._publisher(m.topic, m.msg_type) for m in messages]
         stale = [name for name in self._latched_names if name not in set(outcome.names)]
-        for publisher, (_, message) in zip(publishers, messages):
-            publisher.publish(message)
+        for publisher, message in zip(publishers, messages):
+            publisher.publish(message.data)
         for name in stale:
             self._publisher(name + '/plan', Path).publish(
                 conversions.empty_path(settings.frame_id, outcome.start_ns))
