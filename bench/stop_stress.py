@@ -3,7 +3,7 @@ Stress check of the clean stop: start, one call, SIGINT or SIGTERM at a random m
 
 For each install (the venv's console script; the colcon install built from a
 copy of this checkout with the README's command), ``--cycles`` times: start
-planner_node, wait for its service, send one call (k = 8 or 2048 robots, n = 3),
+planner_node, wait for its service, send one call (k = 8 or 512 robots, n = 3),
 send SIGINT or SIGTERM a random 0-0.3 s after the call (before, during or after
 the plan), wait for the exit. Counts non-zero exits, tracebacks, segfaults and
 hangs (no exit within 40 s), and how many signals landed during a call.

@@ -20,7 +20,7 @@ STOP_TIMEOUT_SEC = 40.0
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
 # The request of a cycle: n configurations of k robots (k drawn from ROBOTS), so a
 # signal sent within MAX_DELAY_SEC of the call lands before, during or after it.
-ROBOTS = (8, 2048)
+ROBOTS = (8, 512)
 CONFIGURATIONS = 3
 MAX_DELAY_SEC = 0.3
 OBSTACLES = '[-2.0, 0.5, 0.0, 0.0, -0.5, 0.0, 2.5, 0.0, 0.0]'

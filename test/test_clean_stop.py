@@ -19,7 +19,7 @@ from stop_check import run_cycle
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
 # Both signals during a large call (answered before stopping) and with the node idle.
-FIXED = [(signal.SIGINT, 2048, 0.02), (signal.SIGTERM, 2048, 0.02),
+FIXED = [(signal.SIGINT, 512, 0.02), (signal.SIGTERM, 512, 0.02),
          (signal.SIGINT, 8, 0.25), (signal.SIGTERM, 8, 0.25)]
 
 
