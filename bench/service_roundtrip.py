@@ -33,6 +33,10 @@ from node_session import planner_session
 import numpy as np
 from punctured_planner.cli import call_service
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                                'test'))
+from stop_check import random_request  # noqa: E402 - test/ helper, as bench/stop_stress.py
+
 OBSTACLES = [-2.0, 0.5, 0.0, 0.0, -0.5, 0.0, 2.5, 0.0, 0.0]
 SWEEP = (2, 8, 64, 512, 2048)
 MAX_POSES = 100000000
@@ -41,25 +45,6 @@ MAX_POSES = 100000000
 def calls_for(k):
     """Return how many timed calls to make for k robots (fewer for large k)."""
     return 200 if k <= 8 else 100 if k <= 64 else 20 if k <= 512 else 6
-
-
-def make_request(rng, k, n, spread=None):
-    """Return a PlanSequence request: n configurations of k robots, uniform in a square."""
-    from geometry_msgs.msg import Pose
-    from geometry_msgs.msg import PoseArray
-    from punctured_planner_interfaces.srv import PlanSequence
-    spread = spread or max(10.0, 2.0 * np.sqrt(k))
-    request = PlanSequence.Request()
-    for _ in range(n):
-        configuration = PoseArray()
-        configuration.header.frame_id = 'map'
-        for x, y in rng.uniform(-spread, spread, size=(k, 2)).tolist():
-            pose = Pose()
-            pose.position.x, pose.position.y = x, y
-            configuration.poses.append(pose)
-        request.configurations.append(configuration)
-    request.max_speed = 1.0
-    return request
 
 
 def call(executor, client, request, timeout_sec=120.0):
@@ -86,7 +71,7 @@ def echo_server(ks, n):
     from rclpy.node import Node
     prebuilt = {}
     for k in ks:
-        outcome = offline_plan(make_request(np.random.default_rng(k), k, n), settings())
+        outcome = offline_plan(random_request(np.random.default_rng(k), k, n), settings())
         assert outcome.ok, outcome.response.error_msg
         prebuilt[k] = outcome.response
 
@@ -116,7 +101,7 @@ def measure(executor, client, echo, k, n, calls, seed=1):
     """
     from rclpy.serialization import serialize_message
     rng = np.random.default_rng(seed)
-    requests = [make_request(rng, k, n) for _ in range(calls + 2)]
+    requests = [random_request(rng, k, n) for _ in range(calls + 2)]
     for request in requests[:2]:  # warm-up: publishers for these robot names, caches
         timed_call(executor, client, request)
         timed_call(executor, echo, request)

@@ -64,7 +64,11 @@ class Cycle:
 
 
 def random_request(rng, k, n=CONFIGURATIONS):
-    """Return a PlanSequence request of n configurations of k robots in a square."""
+    """
+    Return a PlanSequence request of n configurations of k robots in a square.
+
+    Also the requests of bench/service_roundtrip.py.
+    """
     from geometry_msgs.msg import Pose
     from geometry_msgs.msg import PoseArray
     from punctured_planner_interfaces.srv import PlanSequence
