@@ -9,8 +9,8 @@ deserialised here. Seeded random requests, n configurations of k robots.
 
 The floor, measured in the same run: an echo server in a process of its own
 (this script with ``--echo-server``, spun the way the node is) answers the same
-requests over the same DDS with a prebuilt response of the same size (the
-offline plan of a request of the same k and n). Its round trip is what rclpy
+requests over the same DDS with prebuilt responses of the same size (the
+offline plan of each request, built before serving). Its round trip is what rclpy
 and DDS cost alone: the request taken and converted, the response converted,
 serialised, sent, deserialised here. Calls to the two alternate.
 
@@ -58,12 +58,26 @@ def settings():
     return settings_from_values({'obstacles': OBSTACLES, 'max_poses': MAX_POSES})
 
 
-def echo_server(ks, n):
-    """
-    Serve ``echo_sequence``: a prebuilt response per k, of the node's size for k robots.
+def requests_for(k, n, calls, seed=1):
+    """Return the seeded requests of one k: two warm-up calls, then ``calls`` timed ones."""
+    rng = np.random.default_rng(seed)
+    return [random_request(rng, k, n) for _ in range(calls + 2)]
 
-    The floor of the round trip: no planning and no message building per call.
-    Runs until SIGINT or SIGTERM, like the node (punctured_planner.shutdown).
+
+def _key(request):
+    """Return what tells the benchmark's requests apart: k and the first robot's x."""
+    poses = request.configurations[0].poses
+    return len(poses), poses[0].position.x
+
+
+def echo_server(ks, n, calls):
+    """
+    Serve ``echo_sequence``: for each request the benchmark sends, a prebuilt response.
+
+    Each is the offline plan's response to that very request (the node's size
+    to the byte), built before serving: the floor of the round trip, with no
+    planning and no message building per call. Runs until SIGINT or SIGTERM,
+    like the node (punctured_planner.shutdown).
     """
     from punctured_planner.cli import offline_plan
     from punctured_planner.shutdown import run_nodes
@@ -71,14 +85,15 @@ def echo_server(ks, n):
     from rclpy.node import Node
     prebuilt = {}
     for k in ks:
-        outcome = offline_plan(random_request(np.random.default_rng(k), k, n), settings())
-        assert outcome.ok, outcome.response.error_msg
-        prebuilt[k] = outcome.response
+        for request in requests_for(k, n, calls or calls_for(k)):
+            outcome = offline_plan(request, settings())
+            assert outcome.ok, outcome.response.error_msg
+            prebuilt[_key(request)] = outcome.response
 
     def make_nodes(context):
         node = Node('echo_server', context=context)
         node.create_service(PlanSequence, 'echo_sequence',
-                            lambda request, _: prebuilt[len(request.configurations[0].poses)])
+                            lambda request, _: prebuilt[_key(request)])
         return [node]
     return run_nodes(make_nodes, args=sys.argv)
 
@@ -100,8 +115,7 @@ def measure(executor, client, echo, k, n, calls, seed=1):
     Each request goes to the node, then to the echo server (alternating).
     """
     from rclpy.serialization import serialize_message
-    rng = np.random.default_rng(seed)
-    requests = [random_request(rng, k, n) for _ in range(calls + 2)]
+    requests = requests_for(k, n, calls, seed)
     for request in requests[:2]:  # warm-up: publishers for these robot names, caches
         timed_call(executor, client, request)
         timed_call(executor, echo, request)
@@ -112,8 +126,8 @@ def measure(executor, client, echo, k, n, calls, seed=1):
         planning.append(response.planning_time.sec + response.planning_time.nanosec * 1e-9)
         seconds, echoed = timed_call(executor, echo, request)
         floor.append(seconds)
-    size = len(serialize_message(response))
-    assert abs(len(serialize_message(echoed)) - size) < 16 * k + 64, 'echo of another size'
+        size = len(serialize_message(response))
+        assert len(serialize_message(echoed)) == size, 'echo of another size'
     return np.array(trips), np.array(floor), np.array(planning), size
 
 
@@ -129,13 +143,14 @@ def main(argv=None):
     args, _ = parser.parse_known_args(argv)
     ks = SWEEP if args.sweep else (args.k,)
     if args.echo_server:
-        return echo_server(ks, args.n)
+        return echo_server(ks, args.n, args.calls)
     parameters = {'obstacles': '[%s]' % ','.join(str(v) for v in OBSTACLES),
                   'max_poses': MAX_POSES}
     with planner_session('bench', parameters) as session:
         from punctured_planner_interfaces.srv import PlanSequence
         echo_process = subprocess.Popen(
             [sys.executable, __file__, '--echo-server', '-n', str(args.n)]
+            + (['--calls', str(args.calls)] if args.calls else [])
             + (['--sweep'] if args.sweep else ['-k', str(args.k)])
             + ['--ros-args', '-r', '__ns:=' + session.namespace + '_echo'],
             stdout=subprocess.DEVNULL, stdin=subprocess.DEVNULL)
@@ -146,7 +161,7 @@ def main(argv=None):
                                               session.namespace + '_echo/echo_sequence')
             started = time.perf_counter()
             if not (client.wait_for_service(timeout_sec=30)
-                    and echo.wait_for_service(timeout_sec=120)):
+                    and echo.wait_for_service(timeout_sec=600)):
                 print('service not discovered; node log: %s' % session.log_path)
                 return 1
             print('planner_node and the echo server in their own processes, discovered in '
