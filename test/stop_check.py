@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import signal
 import subprocess
 import time
+from typing import Optional
 
 import numpy as np
 
@@ -36,7 +37,7 @@ class Cycle:
     served: bool  # the service was discovered
     during_call: bool  # the signal went out while the call was unanswered
     answered: bool  # the response arrived
-    returncode: int  # None: still running after STOP_TIMEOUT_SEC (killed)
+    returncode: Optional[int]  # None: still running after STOP_TIMEOUT_SEC (killed)
     output: str
 
     @property
