@@ -25,6 +25,8 @@ EXIT_OK = 0
 EXIT_PLANNER_ERROR = 1
 EXIT_USAGE = 2
 EXIT_NO_SERVICE = 3
+EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a tool stopped by Ctrl-C
+EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, as a shell reports a tool whose reader went away
 
 
 def load_request(path):
@@ -290,7 +292,12 @@ def main(argv=None):
     try:
         return args.func(args)
     except KeyboardInterrupt:
-        return 130
+        return EXIT_INTERRUPTED
+    except BrokenPipeError:
+        # The reader closed the pipe (`... | head`): stop quietly, as Unix tools do.
+        # Standard output goes to /dev/null so the flush at exit cannot fail again.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_BROKEN_PIPE
 
 
 if __name__ == '__main__':

@@ -27,7 +27,9 @@ Conventions:
 from builtin_interfaces.msg import Duration
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import Point
+from geometry_msgs.msg import Pose
 from geometry_msgs.msg import PoseStamped
+from geometry_msgs.msg import Quaternion
 from nav_msgs.msg import Path
 import numpy as np
 from std_msgs.msg import Header
@@ -143,40 +145,116 @@ def stamps_ns(start_ns, seconds):
     return int(start_ns) + np.maximum.accumulate(offsets - steps) + steps
 
 
+def _filled(message_type, **fields):
+    """
+    Return a message of ``message_type`` with ``fields`` stored in its slots directly.
+
+    rosidl's generated classes keep field f in slot ``_f`` (beside
+    ``_check_fields``); their constructor builds a default for every nested
+    message first, and for the k x M poses of a plan that churn was most of the
+    time spent building the response. The values must already have the field
+    types (floats, messages); test_conversions compares the results with
+    constructed messages.
+    """
+    message = object.__new__(message_type)
+    message._check_fields = False
+    for name, value in fields.items():
+        setattr(message, '_' + name, value)
+    return message
+
+
+class Paths(list):
+    """The robots' nav_msgs/Paths, and ``serialized``: the same Paths as CDR bytes (topics)."""
+
+    serialized = ()
+
+
 def plan_to_paths(samples, orientations, frame_id, start_ns, plane_z=0.0):
     """
     Return one nav_msgs/Path per robot for a plan's Samples (see the module docstring).
 
     orientations (n, k, 4) are the input orientations at the waypoints; start_ns
     the stamp of the first pose. samples is ``plan.sample(samples_per_leg,
-    max_speed)``: no pose twice, C_m exactly at ``samples.waypoints[m]``. All
-    paths share one Header object per stamp, so their stamps are identical by
-    construction.
+    max_speed)``: no pose twice, C_m exactly at ``samples.waypoints[m]``.
+    Built once, for the response and the topics alike: a :class:`Paths` of the
+    messages (all paths share one Header object per stamp, so their stamps are
+    identical by construction, and each robot one Quaternion per waypoint; each
+    pose is filled in place by :func:`_filled`, with no default sub-messages)
+    and the same values serialised with numpy.
     """
-    xyz = to_xyz(samples.positions, plane_z)
-    quaternions = normalized_quaternions(orientations)
-    headers = [Header(frame_id=frame_id, stamp=time_from_ns(stamp))
-               for stamp in stamps_ns(start_ns, samples.values).tolist()]
-    xyz_list = xyz.transpose(1, 0, 2).tolist()
-    held = quaternions[samples.last_waypoint()].transpose(1, 0, 2).tolist()
-    paths = []
-    for robot_xyz, robot_held in zip(xyz_list, held):
+    xyz = to_xyz(samples.positions, plane_z).transpose(1, 0, 2)
+    quaternions = normalized_quaternions(orientations).transpose(1, 0, 2)
+    stamps = stamps_ns(start_ns, samples.values)
+    waypoint = samples.last_waypoint()
+    headers = [Header(frame_id=frame_id, stamp=time_from_ns(stamp)) for stamp in stamps.tolist()]
+    held = [[_filled(Quaternion, x=qx, y=qy, z=qz, w=qw) for qx, qy, qz, qw in robot]
+            for robot in quaternions.tolist()]
+    paths = Paths()
+    paths.serialized = _serialized_paths(frame_id, start_ns, stamps, np.concatenate(
+        [xyz, quaternions[:, waypoint]], axis=-1))
+    new = object.__new__
+    for robot_xyz, robot_held in zip(xyz.tolist(), held):
         poses = []
-        for header, (x, y, z), (qx, qy, qz, qw) in zip(headers, robot_xyz, robot_held):
-            # Fill a default PoseStamped in place: its constructor builds the nested
-            # defaults anyway, so passing new nested messages would build them twice.
-            stamped = PoseStamped()
-            stamped.header = header
-            pose = stamped.pose
-            position = pose.position
-            position.x, position.y, position.z = x, y, z
-            orientation = pose.orientation
-            orientation.x, orientation.y, orientation.z, orientation.w = qx, qy, qz, qw
+        for header, (x, y, z), m in zip(headers, robot_xyz, waypoint.tolist()):
+            point = new(Point)
+            point._x, point._y, point._z, point._check_fields = x, y, z, False
+            pose = new(Pose)
+            pose._position, pose._orientation = point, robot_held[m]
+            pose._check_fields = False
+            stamped = new(PoseStamped)
+            stamped._header, stamped._pose, stamped._check_fields = header, pose, False
             poses.append(stamped)
-        path = Path(header=Header(frame_id=frame_id, stamp=time_from_ns(start_ns)))
-        path.poses = poses
-        paths.append(path)
+        paths.append(_filled(Path, header=Header(frame_id=frame_id,
+                                                 stamp=time_from_ns(start_ns)), poses=poses))
     return paths
+
+
+# CDR as rmw_fastrtps writes it: encapsulation header (little endian), then the fields,
+# each aligned to its size counted from the end of the header.
+_CDR_HEADER = b'\x00\x01\x00\x00'
+
+
+def _align(offset, size):
+    return -(-offset // size) * size
+
+
+def _stamped_pose_dtype(frame, start):
+    """Return the numpy layout of a geometry_msgs/PoseStamped in frame ``frame`` at ``start``."""
+    pose = _align(start + 13 + len(frame), 8) - start  # stamp, string (length, bytes, NUL)
+    return np.dtype({'names': ['sec', 'nanosec', 'length', 'frame', 'pose'],
+                     'formats': ['<i4', '<u4', '<u4', 'S%d' % (len(frame) + 1), ('<f8', 7)],
+                     'offsets': [0, 4, 8, 12, pose], 'itemsize': pose + 56})
+
+
+def _serialized_paths(frame_id, start_ns, stamps, values):
+    """
+    Return nav_msgs/Paths serialised, built with numpy: one per row of values (k, M, 7).
+
+    The bytes ``rclpy.serialization.serialize_message`` gives for the Paths of
+    :func:`plan_to_paths` (padding zeroed): header stamp start_ns, poses stamped
+    ``stamps`` (M,) ns in frame_id, with positions and orientations ``values``.
+    """
+    frame = frame_id.encode()
+    robots, count = values.shape[:2]
+    first = _align(13 + len(frame), 4) + 4  # header, then the sequence length
+    head = _stamped_pose_dtype(frame, first)
+    rest = _stamped_pose_dtype(frame, 0)  # a pose ends 8-aligned: the rest repeat
+    size = first + (head.itemsize + (count - 1) * rest.itemsize if count else 0)
+    body = np.zeros((robots, size), dtype=np.uint8)
+    stamp = time_from_ns(start_ns)
+    body[:, :12].view('<u4')[:] = (stamp.sec, stamp.nanosec, len(frame) + 1)
+    body[:, 12:12 + len(frame)] = np.frombuffer(frame, dtype=np.uint8)
+    body[:, first - 4:first].view('<u4')[:] = count
+    for dtype, start, select in ((head, first, slice(0, 1)),
+                                 (rest, first + head.itemsize, slice(1, None))):
+        elements = np.zeros((robots, len(stamps[select])), dtype=dtype)
+        elements['sec'], elements['nanosec'] = divmod(stamps[select], 1000000000)
+        elements['length'] = len(frame) + 1
+        elements['frame'] = frame
+        elements['pose'] = values[:, select]
+        body[:, start:start + elements.shape[1] * dtype.itemsize] = elements.view(
+            np.uint8).reshape(robots, -1)
+    return [_CDR_HEADER + row.tobytes() for row in body]
 
 
 def domain_index_message(plan):

@@ -24,7 +24,9 @@ the subscriptions. Not rclpy's MultiThreadedExecutor: in rclpy 7.1 it busy-
 loops on subscription traffic (ros2/rclpy#1223, #1452), and measured here, with
 obstacles and robot states at 50 Hz, service round trips went from 4 ms to 80
 ms median with stalls of 2-6 s (two single-threaded executors: 3.4 ms, worst 6
-ms). A plan is published only once it is complete.
+ms). A plan is published only once it is complete. Start and stop (Ctrl-C and
+SIGTERM alike, threads joined before anything is destroyed):
+:func:`punctured_planner.shutdown.run_nodes`.
 """
 
 from dataclasses import dataclass
@@ -39,10 +41,7 @@ import numpy as np
 from punctured_planner_interfaces.msg import Plan
 from punctured_planner_interfaces.srv import PlanSequence
 from rcl_interfaces.msg import SetParametersResult
-import rclpy
 from rclpy.exceptions import ParameterException
-from rclpy.executors import ExternalShutdownException
-from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy
 from rclpy.qos import HistoryPolicy
@@ -63,6 +62,7 @@ from .planning import ObstacleSet
 from .planning import PlanSequenceHandler
 from .planning import RobotState
 from .planning import Snapshot
+from .shutdown import run_nodes
 
 
 @dataclass(frozen=True, eq=False)
@@ -291,19 +291,14 @@ class PlannerNode(Node):
     def _publish(self, outcome, settings):
         """Publish the complete plan: every robot's Path, stale robots emptied, markers, index."""
         messages = publications.plan_messages(outcome, settings)
-        publishers = [self._publisher(topic, type(message)) for topic, message in messages]
+        publishers = [self._publisher(m.topic, m.msg_type) for m in messages]
         stale = [name for name in self._latched_names if name not in set(outcome.names)]
-        for publisher, (_, message) in zip(publishers, messages):
-            publisher.publish(message)
+        for publisher, message in zip(publishers, messages):
+            publisher.publish(message.data)
         for name in stale:
             self._publisher(name + '/plan', Path).publish(
                 conversions.empty_path(settings.frame_id, outcome.start_ns))
         self._latched_names = list(outcome.names)
-
-    def destroy_node(self):
-        """Destroy the inputs node too."""
-        self.inputs.destroy_node()
-        return super().destroy_node()
 
     def _retract(self, names, settings):
         """After a failed publish, latch empty paths so no robot keeps a partial plan."""
@@ -323,59 +318,19 @@ class PlannerNode(Node):
         return publisher
 
 
-class Spinner:
-    """Spin a PlannerNode and its inputs node, each on a single-threaded executor."""
-
-    def __init__(self, planner, context=None):
-        """Make one executor per node; nothing spins yet."""
-        self.service_executor = SingleThreadedExecutor(context=context)
-        self.service_executor.add_node(planner)
-        self.inputs_executor = SingleThreadedExecutor(context=context)
-        self.inputs_executor.add_node(planner.inputs)
-        self._threads = [threading.Thread(target=self.inputs_executor.spin, daemon=True)]
-
-    def start(self):
-        """Spin both executors in background threads (call this or spin, once)."""
-        self._threads.append(threading.Thread(target=self.service_executor.spin, daemon=True))
-        for thread in self._threads:
-            thread.start()
-
-    def spin(self):
-        """Spin the inputs in a background thread and the service here, until shutdown."""
-        self._threads[0].start()
-        self.service_executor.spin()
-
-    def shutdown(self):
-        """Shut both executors down and join their threads."""
-        self.service_executor.shutdown()
-        self.inputs_executor.shutdown()
-        for thread in self._threads:
-            if thread.is_alive():
-                thread.join(timeout=10)
+def planner_nodes(context=None, **kwargs):
+    """Return [PlannerNode, its inputs node]: the nodes to spin, each in its own thread."""
+    node = PlannerNode(context=context, **kwargs)
+    return [node, node.inputs]
 
 
 def main(args=None):
     """Run the node until Ctrl-C or SIGTERM; return 0, or 2 for invalid parameters."""
-    rclpy.init(args=args)
-    node = None
-    spinner = None
     try:
-        try:
-            node = PlannerNode()
-        except (ValueError, ParameterException) as error:
-            print('planner_node: invalid parameters: %s' % error, file=sys.stderr)
-            return 2
-        spinner = Spinner(node)
-        spinner.spin()
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        if spinner is not None:
-            spinner.shutdown()
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
-    return 0
+        return run_nodes(planner_nodes, args=args)
+    except (ValueError, ParameterException) as error:
+        print('planner_node: invalid parameters: %s' % error, file=sys.stderr)
+        return 2
 
 
 if __name__ == '__main__':

@@ -6,11 +6,15 @@ looks the same on the topics and in a recording. Conversions of single
 messages are in :mod:`punctured_planner.conversions`.
 """
 
+from dataclasses import dataclass
+
 from geometry_msgs.msg import Point
 from geometry_msgs.msg import Vector3
+from nav_msgs.msg import Path
 import numpy as np
 from std_msgs.msg import ColorRGBA
 from std_msgs.msg import Header
+from std_msgs.msg import UInt32
 from visualization_msgs.msg import Marker
 from visualization_msgs.msg import MarkerArray
 
@@ -116,19 +120,37 @@ def plan_markers(plan, frame_id, stamp_ns, plane_z=0.0, names=None, max_speed=1.
     return MarkerArray(markers=markers)
 
 
+@dataclass(frozen=True)
+class Publication:
+    """One message to publish: relative topic, message type, the message or its CDR bytes."""
+
+    topic: str
+    msg_type: type
+    data: object
+
+    def serialized(self):
+        """Return the message as CDR bytes (as published)."""
+        if isinstance(self.data, bytes):
+            return self.data
+        from rclpy.serialization import serialize_message
+        return serialize_message(self.data)
+
+
 def plan_messages(outcome, settings):
     """
-    Return [(topic, message)] of a successful planning Outcome, as the node publishes them.
+    Return the Publications of a successful planning Outcome, as the node publishes them.
 
-    Topics are relative: ``<robot>/plan`` per robot, ``plan_markers``, ``domain_index``,
-    then ``plan`` (the Plan message, last: an executor never sees a plan whose paths are
-    not out).
+    Topics are relative: ``<robot>/plan`` per robot (the bytes built with the
+    response's Paths, :func:`punctured_planner.conversions.plan_to_paths`),
+    ``plan_markers``, ``domain_index``, then ``plan`` (the Plan message, last: an
+    executor never sees a plan whose paths are not out).
     """
-    messages = [('%s/plan' % name.strip('/'), path)
-                for name, path in zip(outcome.names, outcome.paths)]
-    messages.append(('plan_markers', plan_markers(outcome.plan, settings.frame_id,
-                                                  outcome.start_ns, settings.plane_z,
-                                                  outcome.names, outcome.max_speed)))
-    messages.append(('domain_index', domain_index_message(outcome.plan)))
-    messages.append(('plan', plan_message(outcome, settings)))
+    messages = [Publication('%s/plan' % name.strip('/'), Path, data)
+                for name, data in zip(outcome.names, outcome.paths.serialized)]
+    messages.append(Publication('plan_markers', MarkerArray, plan_markers(
+        outcome.plan, settings.frame_id, outcome.start_ns, settings.plane_z, outcome.names,
+        outcome.max_speed)))
+    messages.append(Publication('domain_index', UInt32, domain_index_message(outcome.plan)))
+    plan = plan_message(outcome, settings)
+    messages.append(Publication('plan', type(plan), plan))
     return messages

@@ -102,17 +102,18 @@ def message_definition(type_name):
     return '\n'.join(parts) + '\n'
 
 
-def _type_name(message):
-    """Return 'pkg/msg/Type' of a generated ROS 2 message instance."""
-    module = type(message).__module__.split('.')
-    return '%s/msg/%s' % (module[0], type(message).__name__)
+def _type_name(msg_type):
+    """Return 'pkg/msg/Type' of a generated ROS 2 message class."""
+    return '%s/msg/%s' % (msg_type.__module__.split('.')[0], msg_type.__name__)
 
 
 def write_mcap(path, messages, log_time_ns, metadata=None):
     """
     Write [(topic, message)] to an MCAP file at ``path``; return the path.
 
-    Each message is serialised by rclpy (exact CDR) and logged at
+    A message is a ROS message, serialised by rclpy (exact CDR), or a
+    :class:`punctured_planner.publications.Publication` (recorded as the node
+    publishes it, perhaps bytes already). Each is logged at
     ``log_time_ns``: one time for all, or a sequence with one per message;
     metadata (dict of str) goes into a ``punctured_planner`` metadata record.
     """
@@ -120,7 +121,8 @@ def write_mcap(path, messages, log_time_ns, metadata=None):
     from mcap.well_known import Profile
     from mcap.well_known import SchemaEncoding
     from mcap.writer import Writer
-    from rclpy.serialization import serialize_message
+
+    from .publications import Publication
 
     schemas = {}
     channels = {}
@@ -128,7 +130,9 @@ def write_mcap(path, messages, log_time_ns, metadata=None):
         writer = Writer(stream)
         writer.start(profile=Profile.ROS2, library='punctured_planner')
         for sequence, (topic, message) in enumerate(messages):
-            type_name = _type_name(message)
+            if not isinstance(message, Publication):
+                message = Publication(topic, type(message), message)
+            type_name = _type_name(message.msg_type)
             if type_name not in schemas:
                 schemas[type_name] = writer.register_schema(
                     name=type_name, encoding=SchemaEncoding.ROS2,
@@ -140,7 +144,7 @@ def write_mcap(path, messages, log_time_ns, metadata=None):
             stamp = int(log_time_ns if np.ndim(log_time_ns) == 0 else log_time_ns[sequence])
             writer.add_message(channel_id=channels[topic], log_time=stamp,
                                publish_time=stamp, sequence=sequence,
-                               data=serialize_message(message))
+                               data=message.serialized())
         if metadata:
             writer.add_metadata('punctured_planner',
                                 {str(k): str(v) for k, v in metadata.items()})
@@ -160,5 +164,5 @@ def record_plan(path, outcome, settings):
         'projection_counts': ','.join(str(int(c)) for c in p.projection_counts),
     }
     from .publications import plan_messages
-    messages = [('/' + topic, message) for topic, message in plan_messages(outcome, settings)]
+    messages = [('/' + message.topic, message) for message in plan_messages(outcome, settings)]
     return write_mcap(path, messages, outcome.start_ns, metadata)

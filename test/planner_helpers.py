@@ -2,7 +2,7 @@
 Helpers for the planner node tests: requests, an in-process node, latched subscribers.
 
 The in-process node runs in its own rclpy Context, spun in background threads by
-planner_node's Spinner (as ``main()`` runs it); the test talks to it
+the ExecutorThreads ``main()`` runs it with; the test talks to it
 over real DDS from the ``ros_client`` fixture's own Context.
 """
 
@@ -61,22 +61,24 @@ def unique_namespace(tag='inproc'):
 
 
 class InProcessPlanner:
-    """A PlannerNode in its own Context, spun by planner_node's Spinner in threads."""
+    """A PlannerNode in its own Context, spun in threads as ``main()`` spins it."""
 
     def __init__(self, namespace=None, **parameters):
         """Start the node with parameter overrides (name=value)."""
         import rclpy
         from rclpy.parameter import Parameter
 
-        from punctured_planner.planner_node import PlannerNode, Spinner
+        from punctured_planner.planner_node import planner_nodes
+        from punctured_planner.shutdown import ExecutorThreads
         self.namespace = namespace or unique_namespace()
         self.context = rclpy.context.Context()
         rclpy.init(context=self.context, args=[])
         overrides = [Parameter(name, value=value) for name, value in parameters.items()]
-        self.node = PlannerNode(context=self.context, namespace=self.namespace,
-                                parameter_overrides=overrides)
-        self.spinner = Spinner(self.node, context=self.context)
-        self.spinner.start()
+        nodes = planner_nodes(context=self.context, namespace=self.namespace,
+                              parameter_overrides=overrides)
+        self.node = nodes[0]
+        self.threads = ExecutorThreads(nodes, context=self.context)
+        self.threads.start()
 
     def name(self, relative):
         """Return the absolute name of one of the node's topics or services."""
@@ -89,10 +91,9 @@ class InProcessPlanner:
                                          for name, value in parameters.items()])
 
     def close(self):
-        """Stop the executor thread, destroy the node, shut the Context down."""
+        """Stop the executor threads, destroy the nodes, shut the Context down."""
         import rclpy
-        self.spinner.shutdown()
-        self.node.destroy_node()
+        assert self.threads.close(), 'callbacks still running: %s' % self.threads.stuck()
         rclpy.try_shutdown(context=self.context)
 
 

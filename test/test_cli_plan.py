@@ -123,3 +123,21 @@ def test_plan_gif(capsys, tmp_path, option):
                        str(out), '--gif-seconds', '1', '--gif-fps', '4', '--gif-dpi', '40')
     assert code == 0, err
     assert out.read_bytes()[:6] in (b'GIF89a', b'GIF87a')
+
+
+def test_a_reader_that_goes_away_ends_the_output_quietly(tmp_path):
+    """`punctured-planner plan ... | head -3`: no BrokenPipeError traceback, exit 141."""
+    with open(EXAMPLE, encoding='utf-8') as stream:
+        request = yaml.safe_load(stream)
+    request['samples_per_leg'] = 100  # megabytes of YAML: far more than a pipe holds
+    path = tmp_path / 'long.yaml'
+    path.write_text(yaml.safe_dump(request))
+    process = subprocess.Popen([venv_script('punctured-planner'), 'plan', str(path),
+                                '--params', SCENARIO], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE)
+    head = [process.stdout.readline() for _ in range(3)]
+    process.stdout.close()  # as head does after three lines
+    err = process.stderr.read().decode()
+    assert process.wait(timeout=60) == 141, err
+    assert head[0].startswith(b'error_code: 0')
+    assert err == '', err

@@ -8,50 +8,20 @@ run`` uses: lib/punctured_planner/planner_node) and calls it over DDS.
 
 import os
 import re
-import shlex
-import shutil
 import subprocess
 import sys
 
+from colcon_workspace import build_workspace
+from colcon_workspace import COLCON_BUILD
+from colcon_workspace import installed_node_command
+from colcon_workspace import venv_env
 from conftest import NodeProcess
 from conftest import REPO_ROOT
 import pytest
-
-# The README must show exactly this command (checked below).
-COLCON_BUILD = (
-    'colcon build --base-paths src src/punctured_planner/punctured_planner_interfaces')
-
-IGNORED = shutil.ignore_patterns(
-    '.venv', '.git', 'build', 'install', 'log', '__pycache__', '*.egg-info',
-    '.pytest_cache', '.hypothesis')
-
-
-def _copy_checkout(destination):
-    """Copy what a clone would hold (tracked and not-ignored files) to ``destination``."""
-    try:
-        listing = subprocess.run(
-            ['git', 'ls-files', '-z', '--cached', '--others', '--exclude-standard'],
-            cwd=REPO_ROOT, capture_output=True, check=True, timeout=60).stdout
-    except (OSError, subprocess.CalledProcessError):
-        shutil.copytree(REPO_ROOT, destination, ignore=IGNORED)
-        return
-    for relative in listing.decode().split('\0'):
-        source = os.path.join(REPO_ROOT, relative)
-        if not relative or not os.path.isfile(source):
-            continue  # deleted in the work tree
-        target = os.path.join(destination, relative)
-        os.makedirs(os.path.dirname(target), exist_ok=True)
-        shutil.copy2(source, target)
-
-
-def _venv_env(base_env):
-    venv = sys.prefix
-    env = dict(base_env)
-    env['PATH'] = os.path.join(venv, 'bin') + os.pathsep + env.get('PATH', '')
-    env['VIRTUAL_ENV'] = venv
-    env['AMENT_PREFIX_PATH'] = venv
-    env['CMAKE_PREFIX_PATH'] = venv
-    return env
+from stop_check import node_arguments
+from test_clean_stop import assert_clean
+from test_clean_stop import FIXED
+from test_clean_stop import stop_cycles
 
 
 def test_readme_gives_the_colcon_command():
@@ -66,13 +36,8 @@ def test_readme_gives_the_colcon_command():
 @pytest.mark.ros
 def test_colcon_build_from_a_clone(tmp_path, ros_env, ros_client):
     workspace = tmp_path / 'ws'
-    clone = workspace / 'src' / 'punctured_planner'
-    _copy_checkout(str(clone))
-    env = _venv_env(ros_env)
-
-    result = subprocess.run(
-        shlex.split(COLCON_BUILD), cwd=str(workspace), env=env,
-        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=900)
+    env = venv_env(ros_env)
+    result = build_workspace(workspace, env)
     assert result.returncode == 0, result.stdout[-6000:]
     for package in ('punctured_planner_interfaces', 'punctured_planner'):
         assert 'Finished <<< %s [' % package in result.stdout, result.stdout[-3000:]
@@ -106,9 +71,7 @@ def test_colcon_build_from_a_clone(tmp_path, ros_env, ros_client):
     from punctured_planner_interfaces.srv import PlanSequence
     namespace = '/pp_colcon_test'
     node = NodeProcess(
-        ['bash', '-c', '. install/setup.sh && exec %s --ros-args -r __ns:=%s' % (
-            shlex.quote(str(pkg / 'lib' / 'punctured_planner' / 'planner_node')),
-            namespace)],
+        installed_node_command(workspace, ['--ros-args', '-r', '__ns:=' + namespace]),
         env, str(tmp_path / 'colcon_node.log'), namespace, cwd=str(workspace))
     try:
         client = ros_client.node.create_client(PlanSequence, node.name('plan_sequence'))
@@ -118,3 +81,8 @@ def test_colcon_build_from_a_clone(tmp_path, ros_env, ros_client):
         assert response.error_msg
     finally:
         assert node.stop() == 0, node.log()
+
+    # It stops cleanly on SIGINT and SIGTERM, during a call too (bench/stop_stress.py: 300).
+    cycles = stop_cycles(ros_client, lambda ns: installed_node_command(
+        workspace, node_arguments(ns)), env, tmp_path, FIXED[:2], seed=14, cwd=str(workspace))
+    assert_clean(cycles)

@@ -108,3 +108,61 @@ def test_markers_name_every_part():
     assert markers.markers[0].action == markers.markers[0].DELETEALL
     assert kinds.count('paths') == 4 and kinds.count('waypoints') == 3
     assert [m.text for m in markers.markers if m.ns == 'labels'] == ['a', 'b', 'c', 'd']
+
+
+def reference_paths(samples, orientations, frame_id, start_ns, plane_z=0.0):
+    """Return the Paths as conversions built them before issue 13 (constructed messages)."""
+    from geometry_msgs.msg import PoseStamped
+    from nav_msgs.msg import Path
+    from std_msgs.msg import Header
+    xyz = conversions.to_xyz(samples.positions, plane_z)
+    quaternions = conversions.normalized_quaternions(orientations)[samples.last_waypoint()]
+    stamps = conversions.stamps_ns(start_ns, samples.values).tolist()
+    paths = []
+    for i in range(xyz.shape[1]):
+        path = Path(header=Header(frame_id=frame_id, stamp=conversions.time_from_ns(start_ns)))
+        for j, stamp in enumerate(stamps):
+            stamped = PoseStamped(header=Header(frame_id=frame_id,
+                                                stamp=conversions.time_from_ns(stamp)))
+            position, q = stamped.pose.position, stamped.pose.orientation
+            position.x, position.y, position.z = xyz[j, i].tolist()
+            q.x, q.y, q.z, q.w = quaternions[j, i].tolist()
+            path.poses.append(stamped)
+        paths.append(path)
+    return paths
+
+
+def float_bits(path):
+    """Return every float of a Path's poses as int64 bits (so -0.0 differs from 0.0)."""
+    return np.array([(s.pose.position.x, s.pose.position.y, s.pose.position.z,
+                      s.pose.orientation.x, s.pose.orientation.y, s.pose.orientation.z,
+                      s.pose.orientation.w) for s in path.poses], dtype=float).view(np.int64)
+
+
+@pytest.mark.parametrize('dimension, frame_id, samples_per_leg', [
+    (2, 'map', 0), (2, 'odom', 3), (3, '', 1), (3, 'a_much_longer_frame', 0), (2, 'm', 2)])
+def test_paths_and_their_bytes_are_the_reference_messages(dimension, frame_id,
+                                                          samples_per_leg):
+    """The response's Paths and the topics' bytes hold exactly the reference's values."""
+    from nav_msgs.msg import Path
+    from rclpy.serialization import deserialize_message
+    from rclpy.serialization import serialize_message
+    configurations = np.array(CONFIGURATIONS, dtype=float)
+    if dimension == 3:
+        configurations[:, :, 2] = [[0.5, -1.0, 2.0, 0.0]] * 3
+    samples = core_plan(configurations, dimension=dimension).sample(samples_per_leg, 0.7)
+    orientations = np.random.default_rng(dimension + samples_per_leg).normal(size=(3, 4, 4))
+    orientations[0, 1] = 0.0
+    orientations[1, 2, 0] = math.nan
+    orientations[2, 3] = [-0.0, 0.0, -0.0, 1.0]
+    arguments = (samples, orientations, frame_id, 1234567890 * 10 ** 9 + 987654321)
+    expected = reference_paths(*arguments)
+    paths = conversions.plan_to_paths(*arguments)
+    assert paths == expected
+    assert len(paths.serialized) == len(paths) == 4
+    for path, reference, data in zip(paths, expected, paths.serialized):
+        assert np.array_equal(float_bits(path), float_bits(reference))
+        assert len(data) == len(serialize_message(reference))
+        decoded = deserialize_message(data, Path)
+        assert decoded == reference
+        assert np.array_equal(float_bits(decoded), float_bits(reference))

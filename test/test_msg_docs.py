@@ -34,6 +34,38 @@ def parse_interface(path):
     return sections
 
 
+def interface_comments(path):
+    """Return {field or constant name: its same-line comment} of a .srv/.msg file."""
+    comments = {}
+    with open(path, encoding='utf-8') as stream:
+        for raw in stream:
+            code, _, comment = raw.partition('#')
+            match = LINE.match(code.strip())
+            if match:
+                comments[match.group('name')] = comment.strip()
+    return comments
+
+
+def first_sentence(text):
+    """Return text up to its first full stop followed by a space or the end (code spans kept)."""
+    masked = re.sub(r'`[^`]*`', lambda m: '_' * len(m.group()), text)
+    end = re.search(r'\.(\s|$)', masked)
+    return text[:end.start() + 1] if end else text
+
+
+def page_meanings(page):
+    """Return {field or constant name: meaning} from the tables of a msg_docs page."""
+    meanings = {}
+    for line in page.splitlines():
+        cells = [cell.strip() for cell in line.strip().strip('|').split('|')]
+        if len(cells) < 3:
+            continue
+        name = cells[1] if re.fullmatch(r'\d+', cells[0]) else cells[0]
+        if re.fullmatch(r'`\w+`', name):
+            meanings[name.strip('`')] = cells[-1]
+    return meanings
+
+
 def interface_files():
     """Return every .srv, .msg and .action file of the interface package."""
     return sorted(glob.glob(os.path.join(INTERFACES, 'srv', '*.srv'))
@@ -76,6 +108,22 @@ def test_parser_sees_the_execute_plan_sections():
     assert ('uint64', 'plan_id', None) in goal
     assert ('uint16', 'UNSAFE_PLAN', '4') in result
     assert ('string[]', 'stale_robots', None) in feedback
+
+
+def test_each_field_and_constant_has_the_pages_first_sentence_as_comment():
+    """`ros2 interface show` explains each line: its comment opens its msg_docs row."""
+    path = os.path.join(INTERFACES, 'srv', 'PlanSequence.srv')
+    with open(os.path.join(DOCS, 'PlanSequence.md'), encoding='utf-8') as stream:
+        meanings = page_meanings(stream.read())
+    comments = interface_comments(path)
+    for section in parse_interface(path):
+        for _, field, _ in section:
+            assert comments[field] == first_sentence(meanings[field]), field
+
+
+def test_first_sentence_skips_full_stops_in_code():
+    assert first_sentence('Sum `a + ... + b`. More.') == 'Sum `a + ... + b`.'
+    assert first_sentence('Uses 1.5 m. Then') == 'Uses 1.5 m.'
 
 
 def test_parser_sees_the_plan_sequence_definition():

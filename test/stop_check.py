@@ -1,0 +1,146 @@
+"""
+One stop cycle of a node process: start, one call, SIGINT or SIGTERM at a random moment.
+
+Shared by the short check in ``make test`` (test/test_clean_stop.py, a few cycles
+per install) and the stress benchmark (bench/stop_stress.py, 300 cycles per
+install). A cycle is clean when the process exits 0 with no traceback in its
+output; a segfault (exit -11), an abort or a hang (still running
+``STOP_TIMEOUT_SEC`` after the signal, then killed) is not.
+"""
+
+from dataclasses import dataclass
+import signal
+import subprocess
+import time
+from typing import Optional
+
+import numpy as np
+
+# Seconds a stopped node may take to exit: its shutdown.STOP_TIMEOUT_SEC plus margin.
+STOP_TIMEOUT_SEC = 40.0
+SIGNALS = (signal.SIGINT, signal.SIGTERM)
+# The request of a cycle: n configurations of k robots (k drawn from ROBOTS), so a
+# signal sent within MAX_DELAY_SEC of the call lands before, during or after it.
+ROBOTS = (8, 512)
+CONFIGURATIONS = 3
+MAX_DELAY_SEC = 0.3
+OBSTACLES = '[-2.0, 0.5, 0.0, 0.0, -0.5, 0.0, 2.5, 0.0, 0.0]'
+
+
+@dataclass
+class Cycle:
+    """What one cycle did and how the process ended."""
+
+    signal_name: str
+    robots: int
+    delay_sec: float  # from sending the call to sending the signal
+    served: bool  # the service was discovered
+    during_call: bool  # the signal went out while the call was unanswered
+    answered: bool  # the response arrived
+    returncode: Optional[int]  # None: still running after STOP_TIMEOUT_SEC (killed)
+    output: str
+
+    @property
+    def traceback(self):
+        """Return whether the process printed a Python traceback."""
+        return 'Traceback (most recent call last)' in self.output
+
+    @property
+    def segfault(self):
+        """Return whether the process died of SIGSEGV."""
+        return self.returncode == -signal.SIGSEGV or 'Segmentation fault' in self.output
+
+    @property
+    def clean(self):
+        """Return whether the process exited 0 with no traceback."""
+        return self.returncode == 0 and not self.traceback
+
+    def describe(self):
+        """Return a one-line account of the cycle, with the output when it was not clean."""
+        line = ('%s at %.3f s after the call (k=%d, %s), exit %s'
+                % (self.signal_name, self.delay_sec, self.robots,
+                   'during the call' if self.during_call else
+                   'answered before' if self.answered else 'not served', self.returncode))
+        return line if self.clean else line + ':\n' + self.output[-4000:]
+
+
+def random_request(rng, k, n=CONFIGURATIONS):
+    """
+    Return a PlanSequence request of n configurations of k robots in a square.
+
+    Also the requests of bench/service_roundtrip.py.
+    """
+    from geometry_msgs.msg import Pose
+    from geometry_msgs.msg import PoseArray
+    from punctured_planner_interfaces.srv import PlanSequence
+    spread = max(10.0, 2.0 * np.sqrt(k))
+    request = PlanSequence.Request()
+    for _ in range(n):
+        configuration = PoseArray()
+        configuration.header.frame_id = 'map'
+        for x, y in rng.uniform(-spread, spread, size=(k, 2)).tolist():
+            pose = Pose()
+            pose.position.x, pose.position.y = x, y
+            configuration.poses.append(pose)
+        request.configurations.append(configuration)
+    request.max_speed = 1.0
+    return request
+
+
+def node_arguments(namespace):
+    """Return the ROS arguments of a cycle's node: its namespace and three obstacles."""
+    return ['--ros-args', '-r', '__ns:=' + namespace, '-p', 'obstacles:=' + OBSTACLES]
+
+
+def draw(rng):
+    """Return a random (signal number, robots k, delay s): SIGINT or SIGTERM, k in ROBOTS."""
+    return (SIGNALS[rng.integers(len(SIGNALS))], int(ROBOTS[rng.integers(len(ROBOTS))]),
+            float(rng.uniform(0.0, MAX_DELAY_SEC)))
+
+
+def run_cycle(client_node, executor, command, env, namespace, log_path, choice, rng,
+              cwd=None):
+    """
+    Run one cycle of ``command`` (a planner_node in ``namespace``); return a Cycle.
+
+    ``client_node`` and ``executor`` are the caller's rclpy node and its
+    executor; ``choice`` is (signal number, k, delay s) as :func:`draw` returns
+    it: the signal goes out ``delay`` seconds after the call, whose request of
+    k robots is drawn from ``rng``.
+    """
+    from punctured_planner_interfaces.srv import PlanSequence
+    number, k, delay = choice
+    request = random_request(rng, k)
+    with open(log_path, 'wb') as log:
+        process = subprocess.Popen(command, env=env, cwd=cwd, stdout=log,
+                                   stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
+        client = client_node.create_client(PlanSequence, namespace + '/plan_sequence')
+        try:
+            served = client.wait_for_service(timeout_sec=30.0)
+            future = client.call_async(request)
+            sent = time.monotonic()
+            while time.monotonic() < sent + delay:
+                executor.spin_once(timeout_sec=0.002)
+            during = served and not future.done()
+            process.send_signal(number)
+            deadline = time.monotonic() + STOP_TIMEOUT_SEC
+            while process.poll() is None and time.monotonic() < deadline:
+                executor.spin_once(timeout_sec=0.01)
+            if process.poll() is None:
+                process.kill()
+                process.wait()
+                returncode = None
+            else:
+                returncode = process.returncode
+            answered = future.done()
+            if not answered:
+                client.remove_pending_request(future)
+        finally:
+            if process.poll() is None:
+                process.kill()
+                process.wait()
+            client_node.destroy_client(client)
+    with open(log_path, 'rb') as stream:
+        output = stream.read().decode('utf-8', 'replace')
+    return Cycle(signal.Signals(number).name, k, delay, served, during, answered, returncode,
+                 output)
