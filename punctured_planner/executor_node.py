@@ -44,6 +44,7 @@ from . import conversions
 from .execution import Execution
 from .execution import ExecutionSettings
 from .parameters import descriptor
+from .parameters import node_values
 from .parameters import parameter_value
 from .parameters import Spec
 from .planner_node import LATCHED
@@ -167,7 +168,7 @@ class PlanExecutor(Node):
         for spec in PARAMETERS:
             self.declare_parameter(spec.name, spec.default, descriptor(spec, read_only=(
                 spec.name == 'control_rate')))
-        self._settings = settings_from_values(self._parameter_values())
+        self._settings = settings_from_values(node_values(self, SPECS))
         self.add_on_set_parameters_callback(self._on_set_parameters)
         self._plans = OrderedDict()        # plan id -> KnownPlan
         self._odometry = {}                # robot name -> RobotOdometry
@@ -184,15 +185,10 @@ class PlanExecutor(Node):
 
     # ------------------------------------------------------------ parameters
 
-    def _parameter_values(self):
-        return {name: self.get_parameter(name).value for name in SPECS}
-
     def _on_set_parameters(self, parameters):
         """Refuse a change that makes the settings invalid; apply it at the next goal."""
-        values = self._parameter_values()
-        values.update({p.name: p.value for p in parameters if p.name in SPECS})
         try:
-            settings = settings_from_values(values)
+            settings = settings_from_values(node_values(self, SPECS, parameters))
         except ValueError as error:
             return SetParametersResult(successful=False, reason=str(error))
         self._settings = settings

@@ -24,6 +24,7 @@ from std_msgs.msg import Header
 from . import conversions
 from .execution import Bodies
 from .parameters import descriptor
+from .parameters import node_values
 from .parameters import parameter_value
 from .parameters import Spec
 from .planner_node import LATCHED
@@ -134,7 +135,7 @@ class FleetSim(Node):
         for spec in PARAMETERS:
             self.declare_parameter(spec.name, spec.default,
                                    descriptor(spec, read_only=spec.name in _FIXED))
-        values = {name: self.get_parameter(name).value for name in SPECS}
+        values = node_values(self, SPECS)
         self._names, positions, settings, self._muted = fleet_from_values(values)
         self._fleet = Fleet(positions, settings)
         self._frame_id = values['frame_id']
@@ -159,8 +160,7 @@ class FleetSim(Node):
 
     def _on_set_parameters(self, parameters):
         """Apply a change of the fleet's physics or muted robots at once, or refuse it."""
-        values = {name: self.get_parameter(name).value for name in SPECS}
-        values.update({p.name: p.value for p in parameters if p.name in SPECS})
+        values = node_values(self, SPECS, parameters)
         try:
             _, _, settings, muted = fleet_from_values(values)
         except ValueError as error:

@@ -268,6 +268,18 @@ def load_parameter_file(path, node_name=NODE_NAME):
     return values
 
 
+def node_values(node, specs, change=()) -> dict:
+    """
+    Return a node's values of the parameters named in specs, with change applied.
+
+    change is the list of rclpy Parameters an on-set callback receives; the
+    caller validates the result (its own settings_from_values).
+    """
+    values = {name: node.get_parameter(name).value for name in specs}
+    values.update({p.name: p.value for p in change if p.name in specs})
+    return values
+
+
 def descriptor(spec, read_only=False):
     """Return the rcl_interfaces ParameterDescriptor of a parameter (imports rclpy types)."""
     from rcl_interfaces.msg import FloatingPointRange

@@ -55,6 +55,7 @@ from . import publications
 from .core import PlanningError
 from .parameters import descriptor
 from .parameters import NODE_NAME
+from .parameters import node_values
 from .parameters import PARAMETERS
 from .parameters import settings_from_values
 from .parameters import SPECS
@@ -97,7 +98,7 @@ class PlannerNode(Node):
         self._plan_count = 0
         for spec in PARAMETERS:
             self.declare_parameter(spec.name, spec.default, descriptor(spec))
-        self._settings = settings_from_values(self._parameter_values())
+        self._settings = settings_from_values(node_values(self, SPECS))
         self.add_on_set_parameters_callback(self._on_set_parameters)
         self.add_post_set_parameters_callback(self._after_set_parameters)
         self._obstacles = self._parameter_obstacles(self._settings)
@@ -131,15 +132,10 @@ class PlannerNode(Node):
 
     # ------------------------------------------------------------ parameters
 
-    def _parameter_values(self):
-        return {name: self.get_parameter(name).value for name in SPECS}
-
     def _on_set_parameters(self, parameters):
         """Refuse a change that makes the settings invalid, with the reason."""
-        values = self._parameter_values()
-        values.update({p.name: p.value for p in parameters if p.name in SPECS})
         try:
-            settings_from_values(values)
+            settings_from_values(node_values(self, SPECS, parameters))
         except ValueError as error:
             return SetParametersResult(successful=False, reason=str(error))
         return SetParametersResult(successful=True)
@@ -153,7 +149,7 @@ class PlannerNode(Node):
 
     def _apply_parameters(self, parameters):
         changed = {p.name for p in parameters}
-        settings = settings_from_values(self._parameter_values())
+        settings = settings_from_values(node_values(self, SPECS))
         with self._lock:
             self._settings = settings
             if 'obstacles' in changed:
