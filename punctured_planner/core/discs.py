@@ -157,10 +157,6 @@ class DiscLayout:
                    max(min_spacing, _SLOT_FACTOR * robot_radius),
                    max(lane_spacing, 2.0 * robot_radius))
 
-    def separation(self, robot_radius: float) -> float:
-        """Return S = max(4R, 2R + max w_j): the robot spacing the theorem assumes."""
-        return max(4.0 * robot_radius, 2.0 * robot_radius + float(self.reach.max(initial=0.0)))
-
     def conflicting_pillars(self, robot_radius: float) -> np.ndarray:
         """
         Return the (c, 2) index pairs j < l of pillars that break condition (c).

@@ -173,7 +173,11 @@ class Plan:
         return self.frame.axis_points(np.array([low - pad, high + pad]))
 
     def lane_segments(self, margin: float = 0.08) -> np.ndarray:
-        """Return the (k, 2, d) end points of the lanes: the axis segment lifted by each lane."""
+        """
+        Return the (L, 2, d) end points of the lanes: the axis segment lifted by each lane.
+
+        One lane per robot (L = k), except for 'discs', whose robots share lanes.
+        """
         return self.axis_segment(margin)[None] + self.lanes[:, None, None] * self.frame.e2
 
     def position(self, tau: npt.ArrayLike) -> np.ndarray:
