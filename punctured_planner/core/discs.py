@@ -192,15 +192,13 @@ def push_factor(relative_height: np.ndarray, full: np.ndarray, zone: np.ndarray)
     return np.clip((zone - np.abs(relative_height)) / (zone - full), 0.0, 1.0)
 
 
-def rise(configuration: np.ndarray, layout: DiscLayout) -> Rise:
+def rise(p: np.ndarray, h: np.ndarray, layout: DiscLayout) -> Rise:
     """
-    Return the sidestep and rise of configuration (k, d) (module docstring).
+    Return the sidestep and rise of a configuration with projections p and offsets h (k,).
 
     The breakpoints are s = 0 (after the sidestep), T, and every s in (0, T)
-    where a robot in a pillar's shadow crosses an edge of its zone.
+    where a robot in a pillar's shadow crosses an edge of its zone (module docstring).
     """
-    frame = layout.frame
-    p, h = frame.project(configuration), frame.offset(configuration)
     if layout.reach.size == 0:
         return Rise(np.zeros(1), np.zeros((1, len(p))))
     total = max(0.0, layout.top - float(h.min()))
@@ -222,25 +220,22 @@ def rise(configuration: np.ndarray, layout: DiscLayout) -> Rise:
     return Rise(lift, shift)
 
 
-def staging_ranks(configuration: np.ndarray, layout: DiscLayout) -> np.ndarray:
-    """Return the (k,) slot of each robot: its rank by projection, ties by index."""
-    p = layout.frame.project(configuration)
+def staging_ranks(p: np.ndarray) -> np.ndarray:
+    """Return the (k,) slot of each robot, from its projection p: its rank, ties by index."""
     rank = np.empty(len(p), dtype=int)
     rank[np.lexsort((np.arange(len(p)), p))] = np.arange(len(p))
     return rank
 
 
-def staging_slots(configuration: np.ndarray, rank: np.ndarray, layout: DiscLayout) -> np.ndarray:
+def staging_slots(p: np.ndarray, rank: np.ndarray, layout: DiscLayout) -> np.ndarray:
     """
-    Return the (k, d) slots of the staging line for configuration (k, d).
+    Return the (k, d) slots of the staging line for robots of projections p (k,).
 
     Slot rank(x) lies (rank - (k - 1) / 2) g along e1 from the mean robot
     projection, on the line at height top.
     """
-    frame = layout.frame
-    centre = frame.project(configuration).mean()
-    along = centre + (rank - (len(rank) - 1) / 2) * layout.slot_spacing
-    return frame.axis_points(along) + layout.top * frame.e2
+    along = p.mean() + (rank - (len(rank) - 1) / 2) * layout.slot_spacing
+    return layout.frame.axis_points(along) + layout.top * layout.frame.e2
 
 
 def shared_lanes(first: np.ndarray, second: np.ndarray) -> np.ndarray:
@@ -286,11 +281,13 @@ def section(configurations: np.ndarray, layout: DiscLayout) -> DiscSection:
     n, k, _ = configurations.shape
     e2 = layout.frame.e2
     deformations = []
-    for configuration in configurations:
-        risen = rise(configuration, layout).positions(configuration, layout.frame)
+    projections = layout.frame.project(configurations)
+    offsets = layout.frame.offset(configurations)
+    for configuration, p, h in zip(configurations, projections, offsets):
+        risen = rise(p, h, layout).positions(configuration, layout.frame)
         names = [SIDESTEP] + [RISE] * (len(risen) - 2)
-        rank = staging_ranks(configuration, layout)
-        deformations.append((risen, names, rank, staging_slots(configuration, rank, layout)))
+        rank = staging_ranks(p)
+        deformations.append((risen, names, rank, staging_slots(p, rank, layout)))
     stages, names, ends, heights = [configurations[0]], [''], [], set()
     for m in range(n - 1):
         risen, rise_names, rank, slots = deformations[m]
