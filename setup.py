@@ -24,9 +24,9 @@ setup(
     license='Apache-2.0',
     entry_points={
         'console_scripts': [
-            'planner_node = punctured_planner.planner_node:main',
-            'plan_executor = punctured_planner.executor_node:main',
-            'fleet_sim = punctured_planner.fleet_sim_node:main',
+            'planner_node = punctured_planner.nodes.planner:main',
+            'plan_executor = punctured_planner.nodes.executor:main',
+            'fleet_sim = punctured_planner.nodes.fleet_sim:main',
             'punctured-planner = punctured_planner.cli:main',
         ],
     },

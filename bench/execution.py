@@ -123,7 +123,7 @@ class Graph:
         import rclpy
         from geometry_msgs.msg import Twist
         from nav_msgs.msg import Odometry
-        from punctured_planner.planner_node import LATCHED
+        from punctured_planner.ros.qos import LATCHED
         from punctured_planner_interfaces.action import ExecutePlan
         from punctured_planner_interfaces.msg import Plan
         from rclpy.action import ActionClient
@@ -178,9 +178,9 @@ class Graph:
 
     def publish_plan(self, the_plan, plan_id):
         """Publish the plan as planner_node would (conversions.plan_message)."""
-        from punctured_planner import conversions
-        from punctured_planner.parameters import Settings
-        from punctured_planner.planning import Outcome
+        from punctured_planner.ros import conversions
+        from punctured_planner.ros.settings import PlannerSettings
+        from punctured_planner.ros.snapshot import Outcome
         n = len(the_plan.configurations)
         start_ns = self.node.get_clock().now().nanoseconds
         paths = conversions.plan_to_paths(the_plan.sample(0, SPEED),
@@ -188,7 +188,7 @@ class Graph:
                                           start_ns)
         outcome = Outcome(response=None, plan=the_plan, paths=paths, names=self.names,
                           start_ns=start_ns, max_speed=SPEED, plan_id=plan_id)
-        self.plan_publisher.publish(conversions.plan_message(outcome, Settings()))
+        self.plan_publisher.publish(conversions.plan_message(outcome, PlannerSettings()))
 
     def execute(self, plan_id, during=None):
         """Send a goal, spin (calling during(feedback) each time); return (result, feedback)."""

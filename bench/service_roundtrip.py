@@ -54,8 +54,8 @@ def call(executor, client, request, timeout_sec=120.0):
 
 def settings():
     """Return the node's settings in this benchmark (as its -p parameters set them)."""
-    from punctured_planner.parameters import settings_from_values
-    return settings_from_values({'obstacles': OBSTACLES, 'max_poses': MAX_POSES})
+    from punctured_planner.ros.settings import PLANNER
+    return PLANNER.settings({'obstacles': OBSTACLES, 'max_poses': MAX_POSES})
 
 
 def requests_for(k, n, calls, seed=1):
@@ -77,10 +77,11 @@ def echo_server(ks, n, calls):
     Each is the offline plan's response to that very request (the node's size
     to the byte), built before serving: the floor of the round trip, with no
     planning and no message building per call. Runs until SIGINT or SIGTERM,
-    like the node (punctured_planner.shutdown).
+    like the node (punctured_planner.ros.runtime).
     """
     from punctured_planner.cli import offline_plan
-    from punctured_planner.shutdown import run_nodes
+    from punctured_planner.ros.runtime import NodeGroup
+    from punctured_planner.ros.runtime import run_nodes
     from punctured_planner_interfaces.srv import PlanSequence
     from rclpy.node import Node
     prebuilt = {}
@@ -94,8 +95,8 @@ def echo_server(ks, n, calls):
         node = Node('echo_server', context=context)
         node.create_service(PlanSequence, 'echo_sequence',
                             lambda request, _: prebuilt[_key(request)])
-        return [node]
-    return run_nodes(make_nodes, args=sys.argv)
+        return NodeGroup([node])
+    return run_nodes('echo_server', make_nodes, args=sys.argv)
 
 
 def timed_call(executor, client, request):

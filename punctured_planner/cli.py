@@ -8,7 +8,7 @@ The request file has the same shape as the ``ros2 service call`` payload.
 
 ``punctured-planner plan REQUEST.yaml [--params FILE]`` answers the same
 request offline, without a ROS graph: the node's checks and conversions
-(:mod:`punctured_planner.planning`) with the parameters of a ROS parameter
+(:mod:`punctured_planner.ros.planning`) with the parameters of a ROS parameter
 file; ``--png``/``--gif`` draw the plan and ``--mcap`` records it as the node
 would publish it.
 """
@@ -39,7 +39,7 @@ def load_request(path):
 
 def build_request(data):
     """Return a PlanSequence.Request filled from plain data (the ros2 YAML shape)."""
-    from punctured_planner.msg_dict import fill_message
+    from punctured_planner.ros.msg_dict import fill_message
     from punctured_planner_interfaces.srv import PlanSequence
     return fill_message(PlanSequence.Request(), data)
 
@@ -167,8 +167,8 @@ def _reset(args):
 
 def print_response(response, no_paths=False):
     """Print a PlanSequence response as YAML (code name on stderr); return the exit code."""
-    from punctured_planner.msg_dict import constant_names
-    from punctured_planner.msg_dict import message_to_dict
+    from punctured_planner.ros.msg_dict import constant_names
+    from punctured_planner.ros.msg_dict import message_to_dict
     from punctured_planner_interfaces.srv import PlanSequence
 
     data = message_to_dict(response)
@@ -192,10 +192,10 @@ def offline_plan(request, settings, now_ns=None):
     The obstacles come from the ``obstacles`` parameter; there is no robot
     state, so ``use_current_state`` gets NO_ROBOT_STATE.
     """
-    from punctured_planner import conversions
-    from punctured_planner.planning import ObstacleSet
-    from punctured_planner.planning import PlanSequenceHandler
-    from punctured_planner.planning import Snapshot
+    from punctured_planner.ros import conversions
+    from punctured_planner.ros.planning import PlanSequenceHandler
+    from punctured_planner.ros.snapshot import ObstacleSet
+    from punctured_planner.ros.snapshot import Snapshot
     from punctured_planner_interfaces.srv import PlanSequence
 
     snapshot = Snapshot(
@@ -206,14 +206,14 @@ def offline_plan(request, settings, now_ns=None):
 
 
 def _plan(args):
-    from punctured_planner.parameters import load_parameter_file
-    from punctured_planner.parameters import settings_from_values
-    from punctured_planner.recording import record_plan
+    from punctured_planner.ros.parameters import load_parameter_file
+    from punctured_planner.ros.recording import record_plan
+    from punctured_planner.ros.settings import PLANNER
     from punctured_planner.render import render_outputs
 
     try:
-        values = load_parameter_file(args.params) if args.params else {}
-        settings = settings_from_values(values)
+        values = load_parameter_file(args.params, PLANNER.node_name) if args.params else {}
+        settings = PLANNER.settings(values)
     except (OSError, yaml.YAMLError, ValueError) as error:
         print('punctured-planner: bad parameter file: %s' % error, file=sys.stderr)
         return EXIT_USAGE

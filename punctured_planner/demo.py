@@ -42,7 +42,7 @@ class Recorder:
         from rclpy.executors import SingleThreadedExecutor
         from std_msgs.msg import Float64
 
-        from .planner_node import LATCHED
+        from .ros.qos import LATCHED
         rclpy.init(args=[])
         self.node = rclpy.create_node('demo', namespace='/demo')
         self.executor = SingleThreadedExecutor()
@@ -91,7 +91,7 @@ def _run(recorder, request_path, mcap_path, gif_path):
     from rclpy.action import ActionClient
 
     from .cli import call_service
-    from .msg_dict import fill_message
+    from .ros.msg_dict import fill_message
     node = recorder.node
     client = node.create_client(PlanSequence, 'plan_sequence')
     action = ActionClient(node, ExecutePlan, 'execute_plan')
@@ -133,8 +133,8 @@ def _run(recorder, request_path, mcap_path, gif_path):
 
 def _write(recorder, response, mcap_path, gif_path):
     """Write demo.mcap and demo.gif from the recorded messages."""
-    from . import conversions
-    from .recording import write_mcap
+    from .ros import conversions
+    from .ros.recording import write_mcap
     from .viz.motion import render_motion
     messages = recorder.messages
     write_mcap(mcap_path, [(t, m) for t, m, _ in messages], [ns for _, _, ns in messages],

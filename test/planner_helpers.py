@@ -68,16 +68,16 @@ class InProcessPlanner:
         import rclpy
         from rclpy.parameter import Parameter
 
-        from punctured_planner.planner_node import planner_nodes
-        from punctured_planner.shutdown import ExecutorThreads
+        from punctured_planner.nodes.planner import planner_nodes
+        from punctured_planner.ros.runtime import ExecutorThreads
         self.namespace = namespace or unique_namespace()
         self.context = rclpy.context.Context()
         rclpy.init(context=self.context, args=[])
         overrides = [Parameter(name, value=value) for name, value in parameters.items()]
-        nodes = planner_nodes(context=self.context, namespace=self.namespace,
+        group = planner_nodes(context=self.context, namespace=self.namespace,
                               parameter_overrides=overrides)
-        self.node = nodes[0]
-        self.threads = ExecutorThreads(nodes, context=self.context)
+        self.node = group.nodes[0]
+        self.threads = ExecutorThreads(group.nodes, context=self.context)
         self.threads.start()
 
     def name(self, relative):
@@ -102,7 +102,7 @@ class Latest:
 
     def __init__(self, node, msg_type, topic):
         """Subscribe to topic with the node's latched QoS."""
-        from punctured_planner.planner_node import LATCHED
+        from punctured_planner.ros.qos import LATCHED
         self.messages = []
         self.subscription = node.create_subscription(msg_type, topic, self.messages.append,
                                                      LATCHED)
@@ -130,7 +130,7 @@ def path_positions(path):
 
 def path_stamps_ns(path):
     """Return the stamps of a nav_msgs/Path's poses as an (M,) integer array (ns)."""
-    from punctured_planner.conversions import stamp_to_ns
+    from punctured_planner.ros.conversions import stamp_to_ns
     return np.array([stamp_to_ns(p.header.stamp) for p in path.poses], dtype=np.int64)
 
 
@@ -142,14 +142,15 @@ def path_array(path):
 def scenario_plan(configurations=CONFIGURATIONS):
     """Return the core's plan with the bundled scenario's parameters (its radii, variant)."""
     from conftest import REPO_ROOT
-    from punctured_planner.parameters import load_parameter_file, settings_from_values
-    settings = settings_from_values(load_parameter_file(
-        os.path.join(REPO_ROOT, 'config', 'default_scenario.yaml')))
+    from punctured_planner.ros.parameters import load_parameter_file
+    from punctured_planner.ros.settings import PLANNER
+    settings = PLANNER.settings(load_parameter_file(
+        os.path.join(REPO_ROOT, 'config', 'default_scenario.yaml'), PLANNER.node_name))
     return core_plan(configurations, variant=settings.core_variant,
                      lane_spacing=settings.lane_spacing, min_spacing=settings.min_spacing,
                      required_clearance=settings.required_clearance,
                      robot_radius=settings.robot_radius,
-                     obstacle_radius=settings.obstacle_radii(len(OBSTACLES)))
+                     obstacle_radius=settings.core_obstacle_radius)
 
 
 def core_plan(configurations=CONFIGURATIONS, obstacles=OBSTACLES, dimension=2, **options):

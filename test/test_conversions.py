@@ -10,8 +10,8 @@ from planner_helpers import OBSTACLES
 from planner_helpers import path_positions
 from planner_helpers import path_stamps_ns
 from planner_helpers import pose_array
-from punctured_planner import conversions
-from punctured_planner import publications
+from punctured_planner.ros import conversions
+from punctured_planner.ros import publications
 import pytest
 
 YAW_90 = [0.0, 0.0, math.sqrt(0.5), math.sqrt(0.5)]
@@ -77,12 +77,12 @@ def test_stamps_strictly_increase_below_a_nanosecond():
 @pytest.mark.parametrize('samples_per_leg', [0, 3])
 def test_no_duplicate_pose_in_paths_markers_or_response(samples_per_leg):
     """Issue: 4 robots, 3 configurations gave 19 poses, 8 repeating position and stamp."""
-    from punctured_planner.parameters import settings_from_values
-    from punctured_planner.planning import ObstacleSet
-    from punctured_planner.planning import PlanSequenceHandler
-    from punctured_planner.planning import Snapshot
+    from punctured_planner.ros.settings import PLANNER
+    from punctured_planner.ros.snapshot import ObstacleSet
+    from punctured_planner.ros.planning import PlanSequenceHandler
+    from punctured_planner.ros.snapshot import Snapshot
     from punctured_planner_interfaces.srv import PlanSequence
-    settings = settings_from_values({'obstacles': [v for o in OBSTACLES for v in o]})
+    settings = PLANNER.settings({'obstacles': [v for o in OBSTACLES for v in o]})
     snapshot = Snapshot(settings, ObstacleSet(np.array(OBSTACLES)))
     outcome = PlanSequenceHandler().handle(
         make_request(samples_per_leg=samples_per_leg), PlanSequence.Response(), snapshot, 0)

@@ -205,11 +205,11 @@ def test_fleet_reports_each_contact_once():
 def test_plan_message_round_trip_to_the_executor_reference():
     """The published Plan carries the motion, the bodies and delta = min_gap / 2."""
     from planner_helpers import make_request
-    from punctured_planner import conversions
     from punctured_planner.cli import offline_plan
-    from punctured_planner.parameters import settings_from_values
-    settings = settings_from_values({'obstacles': [-2.0, 0.5, 0.0, 0.0, -0.5, 0.0,
-                                                   2.5, 0.0, 0.0]})
+    from punctured_planner.ros import conversions
+    from punctured_planner.ros.settings import PLANNER
+    settings = PLANNER.settings({'obstacles': [-2.0, 0.5, 0.0, 0.0, -0.5, 0.0,
+                                               2.5, 0.0, 0.0]})
     outcome = offline_plan(make_request(max_speed=0.5), settings, now_ns=10 ** 18)
     assert outcome.ok
     outcome.plan_id = 3

@@ -11,25 +11,12 @@ import sys
 
 from conftest import REPO_ROOT
 from conftest import venv_script
+from punctured_planner.core import ErrorCode
 import pytest
 import yaml
 
-EXPECTED_CONSTANTS = {
-    'NONE': 0,
-    'NO_CONFIGURATIONS': 1,
-    'NO_ROBOT_STATE': 2,
-    'REQUEST_OVER_LIMITS': 3,
-    'INVALID_REQUEST': 4,
-    'ROBOT_COUNT_MISMATCH': 5,
-    'NON_FINITE_VALUE': 6,
-    'FRAME_MISMATCH': 7,
-    'OFF_PLANE': 8,
-    'OBSTACLES_DEGENERATE': 9,
-    'ROBOTS_COINCIDE': 10,
-    'ROBOT_ON_OBSTACLE': 11,
-    'CLEARANCE_BELOW_REQUIRED': 12,
-    'UNKNOWN': 99,
-}
+# The one table of error codes is the core's; the .srv constants must be it, name for name.
+EXPECTED_CONSTANTS = {code.name: int(code) for code in ErrorCode}
 
 EXPECTED_REQUEST_FIELDS = {
     'configurations': 'sequence<geometry_msgs/PoseArray>',
@@ -132,7 +119,8 @@ def test_request_defaults():
     assert request.samples_per_leg == -1
 
 
-def test_error_code_constants():
+def test_error_code_constants_are_the_core_error_codes():
+    """The core's ErrorCode and PlanSequence.srv: the same names, the same values."""
     response_cls = _plan_sequence().Response
     for name, value in EXPECTED_CONSTANTS.items():
         assert getattr(response_cls, name) == value, name

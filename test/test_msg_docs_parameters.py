@@ -3,9 +3,9 @@
 import os
 
 from conftest import REPO_ROOT
-from punctured_planner import executor_node
-from punctured_planner import fleet_sim_node
-from punctured_planner.parameters import PARAMETERS
+from punctured_planner.ros.settings import EXECUTOR
+from punctured_planner.ros.settings import FLEET_SIM
+from punctured_planner.ros.settings import PLANNER
 import pytest
 
 KINDS = {'string': 'string', 'integer': 'integer', 'double': 'double',
@@ -28,14 +28,14 @@ def expected_row(spec):
 def test_every_parameter_row_matches_the_declaration():
     with open(os.path.join(REPO_ROOT, 'msg_docs', 'parameters.md'), encoding='utf-8') as f:
         rows = [line for line in f.read().splitlines() if line.startswith('| `')]
-    assert rows == [expected_row(spec) for spec in PARAMETERS]
+    assert rows == [expected_row(spec) for spec in PLANNER.specs]
 
 
-@pytest.mark.parametrize('node', [executor_node, fleet_sim_node], ids=lambda m: m.NODE_NAME)
-def test_node_page_parameter_rows_match_the_declarations(node):
+@pytest.mark.parametrize('table', [EXECUTOR, FLEET_SIM], ids=lambda t: t.node_name)
+def test_node_page_parameter_rows_match_the_declarations(table):
     """The '## Parameters' table of msg_docs/<node>.md, row for row."""
-    with open(os.path.join(REPO_ROOT, 'msg_docs', node.NODE_NAME + '.md'),
+    with open(os.path.join(REPO_ROOT, 'msg_docs', table.node_name + '.md'),
               encoding='utf-8') as f:
         section = f.read().split('## Parameters', 1)[1].split('\n## ', 1)[0]
     rows = [line for line in section.splitlines() if line.startswith('| `')]
-    assert rows == [expected_row(spec) for spec in node.PARAMETERS]
+    assert rows == [expected_row(spec) for spec in table.specs]

@@ -4,22 +4,19 @@ import math
 import os
 
 from conftest import REPO_ROOT
-from punctured_planner.parameters import load_parameter_file
-from punctured_planner.parameters import PARAMETERS
-from punctured_planner.parameters import Settings
-from punctured_planner.parameters import settings_from_values
+from punctured_planner.ros.parameters import FRAME_ID
+from punctured_planner.ros.parameters import load_parameter_file
+from punctured_planner.ros.settings import EXECUTOR
+from punctured_planner.ros.settings import FLEET_SIM
+from punctured_planner.ros.settings import PLANNER
 import pytest
 
 
-def test_defaults_are_the_table_defaults():
-    assert settings_from_values({}) == Settings()
-    assert {spec.name for spec in PARAMETERS} == set(Settings.__dataclass_fields__)
-    for spec in PARAMETERS:
-        assert getattr(Settings(), spec.name) == (tuple(spec.default)
-                                                  if isinstance(spec.default, list)
-                                                  else spec.default), spec.name
-    good = settings_from_values({'plane_z': 1, 'obstacles': [0, 0, 0], 'robot_names': None})
-    assert good.plane_z == 1.0 and good.obstacles == (0.0, 0.0, 0.0)
+def test_values_take_the_parameter_kinds():
+    """YAML integers become doubles, lists become tuples, None an empty list."""
+    good = PLANNER.settings({'plane_z': 1, 'obstacles': [0, 0, 0], 'robot_names': None})
+    assert isinstance(good.plane_z, float) and good.plane_z == 1.0
+    assert good.obstacles == (0.0, 0.0, 0.0) and good.robot_names == ()
 
 
 @pytest.mark.parametrize('values, words', [
@@ -33,18 +30,66 @@ def test_defaults_are_the_table_defaults():
 ])
 def test_settings_validation_gives_reasons(values, words):
     with pytest.raises(ValueError, match=words):
-        settings_from_values(values)
+        PLANNER.settings(values)
 
 
 def test_parameter_files(tmp_path):
-    values = load_parameter_file(os.path.join(REPO_ROOT, 'config', 'default_scenario.yaml'))
-    settings = settings_from_values(values)
+    values = load_parameter_file(os.path.join(REPO_ROOT, 'config', 'default_scenario.yaml'),
+                                 PLANNER.node_name)
+    settings = PLANNER.settings(values)
     assert settings.robot_count == 4 and len(settings.obstacles) == 9
     path = tmp_path / 'p.yaml'
     path.write_text('/**:\n  ros__parameters: {variant: paper}\n'
                     'other_node:\n  ros__parameters: {variant: spread}\n'
                     '/fleet/planner_node:\n  ros__parameters: {max_speed: 2}\n')
-    assert load_parameter_file(str(path)) == {'variant': 'paper', 'max_speed': 2}
+    assert load_parameter_file(str(path), 'planner_node') == {'variant': 'paper',
+                                                              'max_speed': 2}
     path.write_text('- not a mapping\n')
     with pytest.raises(ValueError):
-        load_parameter_file(str(path))
+        load_parameter_file(str(path), 'planner_node')
+
+
+@pytest.mark.parametrize('table, values, words', [
+    (EXECUTOR, {'mode': 'torque'}, 'mode must be one of velocity, reference'),
+    (EXECUTOR, {'shared_clock': 'yes'}, 'shared_clock'),
+    (EXECUTOR, {'slow_fraction': 0.7}, 'below hold_fraction'),
+    (EXECUTOR, {'gain': -1.0}, r'gain must be in \[0.0, 100.0\]'),
+    (FLEET_SIM, {'robot_names': ['a'], 'initial_positions': [0.0, 0.0]}, '3 per robot'),
+    (FLEET_SIM, {'robot_names': ['a', 'a'], 'initial_positions': [0.0] * 6}, 'unique'),
+    (FLEET_SIM, {'muted_robots': ['b']}, 'not among robot_names'),
+    (FLEET_SIM, {'robot_names': ['a'], 'initial_positions': [0.0] * 3,
+                 'speed_factors': [11.0]}, r'outside \[0, 10\]'),
+    (FLEET_SIM, {'robot_names': ['a'], 'initial_positions': [0.0] * 3,
+                 'latencies': [0.1, 0.2]}, '2 values for 1 robots'),
+    (FLEET_SIM, {'obstacles': [0.0] * 6, 'obstacle_radius': [1.0] * 3}, 'one each'),
+    (FLEET_SIM, {'frame_id': ''}, 'frame_id must not be empty'),
+])
+def test_executor_and_simulator_validation_gives_reasons(table, values, words):
+    with pytest.raises(ValueError, match=words):
+        table.settings(values)
+
+
+def test_shared_specs_are_one_object_in_every_table():
+    """frame_id, obstacles and the radii: the same Spec (one check, one range) everywhere."""
+    for name in ('frame_id', 'obstacles', 'robot_radius', 'obstacle_radius'):
+        assert PLANNER.by_name[name] is FLEET_SIM.by_name[name], name
+    assert PLANNER.by_name['frame_id'] is FRAME_ID
+
+
+def test_read_only_parameters_are_the_ones_that_shape_the_node():
+    """A descriptor marks read_only exactly where the spec does (one way to mark it)."""
+    read_only = {table.node_name: {s.name for s in table.specs if s.descriptor().read_only}
+                 for table in (PLANNER, EXECUTOR, FLEET_SIM)}
+    assert read_only == {'planner_node': set(), 'plan_executor': {'control_rate'},
+                         'fleet_sim': {'robot_names', 'initial_positions', 'rate', 'seed'}}
+
+
+def test_simulator_settings_become_the_fleet_physics():
+    settings = FLEET_SIM.settings({'robot_names': ['a', 'b'], 'initial_positions': [0.0] * 6,
+                                   'obstacles': [1.0, 2.0, 0.0], 'obstacle_radius': [0.5],
+                                   'robot_radius': 0.2, 'speed_factors': [1.0, 0.5]})
+    fleet = settings.fleet()
+    assert settings.initial.shape == (2, 3)
+    assert fleet.bodies.robot_radius == 0.2
+    assert fleet.bodies.obstacle_radii.tolist() == [0.5]
+    assert fleet.speed_factors.tolist() == [1.0, 0.5] and fleet.latencies is None

@@ -59,7 +59,7 @@ class Graph:
         """Start the nodes in one namespace and connect the client to them."""
         from geometry_msgs.msg import Twist
         from nav_msgs.msg import Odometry
-        from punctured_planner.planner_node import LATCHED
+        from punctured_planner.ros.qos import LATCHED
         from punctured_planner_interfaces.action import ExecutePlan
         from punctured_planner_interfaces.srv import PlanSequence
         from rclpy.action import ActionClient

@@ -61,7 +61,7 @@ def service_client(ros_client, node):
 def test_topics_in_one_path_per_robot_out(planner, ros_client):
     """Obstacles and robot state from topics; each robot's Path matches the core's plan."""
     plan_sequence, pose_array_type, path_type, uint32, marker_array, _ = _types()
-    from punctured_planner.planner_node import LATCHED
+    from punctured_planner.ros.qos import LATCHED
     node = planner(robot_count=4)
     names = ['robot_%d' % i for i in range(4)]
     paths = {name: Latest(ros_client.node, path_type, node.name(name + '/plan'))
@@ -226,11 +226,11 @@ def test_every_error_code_and_the_node_keeps_serving(planner, ros_client, monkey
     node.set_parameters(required_clearance=0.0)
     valid()
 
-    import punctured_planner.planning as planning
+    import punctured_planner.core as core
 
     def broken(*args, **kwargs):
         raise RuntimeError('injected fault')
-    monkeypatch.setattr(planning, 'core_plan', broken)
+    monkeypatch.setattr(core, 'plan', broken)
     expect(make_request(), codes.UNKNOWN, 'injected fault')
     monkeypatch.undo()
     valid()
@@ -431,7 +431,7 @@ def test_a_second_client_context_gets_the_same_latched_plan(planner, ros_client)
 def test_a_bad_obstacle_set_is_refused_on_arrival(planner, ros_client, monkeypatch):
     """Issue 15.4: wrong frame or off the plane: warned and refused, the good set stays."""
     from punctured_planner.cli import reset_obstacles
-    from punctured_planner.planner_node import LATCHED
+    from punctured_planner.ros.qos import LATCHED
     _, pose_array_type, _, _, _, _ = _types()
     node = planner(obstacles=flat(OBSTACLES))
     checked = []

@@ -25,7 +25,7 @@ pytestmark = pytest.mark.ros
 
 def example_request():
     """Return config/example_request.yaml as a PlanSequence request."""
-    from punctured_planner.msg_dict import fill_message
+    from punctured_planner.ros.msg_dict import fill_message
     from punctured_planner_interfaces.srv import PlanSequence
     with open(EXAMPLE, encoding='utf-8') as stream:
         return fill_message(PlanSequence.Request(), yaml.safe_load(stream))

@@ -1,17 +1,17 @@
-"""One request against one snapshot (planning.PlanSequenceHandler), without DDS."""
+"""One request against one snapshot (ros.planning.PlanSequenceHandler), without DDS."""
 
 import numpy as np
 from planner_helpers import make_request
 from planner_helpers import OBSTACLES
-from punctured_planner import conversions
-from punctured_planner.parameters import settings_from_values
-from punctured_planner.planning import ObstacleSet
-from punctured_planner.planning import PlanSequenceHandler
-from punctured_planner.planning import Snapshot
+from punctured_planner.ros import conversions
+from punctured_planner.ros.planning import PlanSequenceHandler
+from punctured_planner.ros.settings import PLANNER
+from punctured_planner.ros.snapshot import ObstacleSet
+from punctured_planner.ros.snapshot import Snapshot
 
 
 def snapshot(**values):
-    settings = settings_from_values(values)
+    settings = PLANNER.settings(values)
     return Snapshot(settings, ObstacleSet(conversions.obstacles_from_parameter(
         settings.obstacles)))
 
@@ -22,7 +22,7 @@ def test_planner_caches_one_workspace_per_obstacle_set():
     base = snapshot(obstacles=[v for o in OBSTACLES for v in o])
     first = planner.workspace(base.settings, np.array(OBSTACLES)[:, :2])
     assert planner.workspace(base.settings, np.array(OBSTACLES)[:, :2]) is first
-    paper = settings_from_values({'variant': 'paper'})
+    paper = PLANNER.settings({'variant': 'paper'})
     assert planner.workspace(paper, np.array(OBSTACLES)[:, :2]) is not first
     outcome = planner.handle(make_request(), PlanSequence.Response(), base, 0)
     assert outcome.ok and outcome.names == ['robot_0', 'robot_1', 'robot_2', 'robot_3']
@@ -68,7 +68,7 @@ def test_discs_answers_over_max_poses_are_refused_once_planned():
 def test_array_holding_dataclasses_compare_by_identity():
     """Frame, ObstacleSet, RobotState, PlaneView: == and hash work (no numpy ValueError)."""
     from punctured_planner.core import Workspace
-    from punctured_planner.planning import RobotState
+    from punctured_planner.ros.snapshot import RobotState
     from punctured_planner.viz.geometry import PlaneView
     frame = Workspace(np.array(OBSTACLES)[:, :2]).frame
     items = [frame, ObstacleSet(np.zeros((2, 3))), RobotState(np.zeros((2, 3)), np.zeros((2, 4))),
@@ -80,9 +80,8 @@ def test_array_holding_dataclasses_compare_by_identity():
 
 def state_snapshot(positions, received_ns, **values):
     """Return a snapshot with the example obstacles and a robot state received then."""
-    from punctured_planner.planning import RobotState
-    settings = settings_from_values({'obstacles': [v for o in OBSTACLES for v in o],
-                                     **values})
+    from punctured_planner.ros.snapshot import RobotState
+    settings = PLANNER.settings({'obstacles': [v for o in OBSTACLES for v in o], **values})
     state = RobotState(np.asarray(positions, dtype=float), np.zeros((len(positions), 4)),
                        'map', received_ns - 7, 'robot_states', received_ns)
     return Snapshot(settings, ObstacleSet(np.array(OBSTACLES)), state)
@@ -159,7 +158,7 @@ def test_messages_name_the_culprit_the_one_way():
 
 def test_log_stamps_keep_every_nanosecond():
     """Issue 15.6: ...870.584161458 was logged as ...870.584161758 through a float."""
-    from punctured_planner.planning import RobotState
+    from punctured_planner.ros.snapshot import RobotState
     stamp = 1700000870584161458
     assert '1700000870.584161458' in ObstacleSet(np.zeros((1, 3)), 'map', '/obstacles',
                                                  stamp).describe()
@@ -178,9 +177,10 @@ def test_bundled_scenario_refuses_a_goal_grazing_an_obstacle():
     import os
     from conftest import REPO_ROOT
     from planner_helpers import CONFIGURATIONS
-    from punctured_planner.parameters import load_parameter_file
-    values = load_parameter_file(os.path.join(REPO_ROOT, 'config', 'default_scenario.yaml'))
-    settings = settings_from_values(values)
+    from punctured_planner.ros.parameters import load_parameter_file
+    values = load_parameter_file(os.path.join(REPO_ROOT, 'config', 'default_scenario.yaml'),
+                                 PLANNER.node_name)
+    settings = PLANNER.settings(values)
     assert settings.required_clearance > 0
     snapshot = Snapshot(settings, ObstacleSet(conversions.obstacles_from_parameter(
         settings.obstacles)))

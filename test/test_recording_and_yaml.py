@@ -1,6 +1,6 @@
 """The MCAP recording's message definitions and the request YAML, without DDS."""
 
-from punctured_planner.recording import message_definition
+from punctured_planner.ros.recording import message_definition
 import pytest
 
 
@@ -18,7 +18,7 @@ def test_full_definition_text_for_recordings():
 
 def test_request_yaml_integers_out_of_range_are_refused():
     """An int32 field given 99999999999 is a clear error, not a silently wrapped value."""
-    from punctured_planner.msg_dict import fill_message
+    from punctured_planner.ros.msg_dict import fill_message
     from punctured_planner_interfaces.srv import PlanSequence
     with pytest.raises(ValueError, match='outside the range of int32'):
         fill_message(PlanSequence.Request(), {'samples_per_leg': 99999999999})

@@ -498,9 +498,10 @@ def test_requests_over_the_limits_are_refused_before_planning(node, client, serv
 
 def test_the_limit_check_runs_before_any_conversion(monkeypatch):
     """In the node's own code path, no message is converted before the limits refuse."""
-    from punctured_planner import conversions
-    from punctured_planner import planning
-    from punctured_planner.parameters import settings_from_values
+    from punctured_planner.ros import conversions
+    from punctured_planner.ros import planning
+    from punctured_planner.ros import snapshot as inputs
+    from punctured_planner.ros.settings import PLANNER
 
     def forbidden(*args, **kwargs):
         raise AssertionError('converted a request that is over the limits')
@@ -508,13 +509,13 @@ def test_the_limit_check_runs_before_any_conversion(monkeypatch):
     for name in ('pose_array_positions', 'pose_array_orientations'):
         monkeypatch.setattr(conversions, name, forbidden)
     monkeypatch.setattr(planning.np, 'stack', forbidden, raising=True)
-    settings = settings_from_values(PARAMETERS)
-    snapshot = planning.Snapshot(settings, planning.ObstacleSet(np.asarray(OBSTACLES)), None)
+    settings = PLANNER.settings(PARAMETERS)
+    snapshot = inputs.Snapshot(settings, inputs.ObstacleSet(np.asarray(OBSTACLES)), None)
     for name, spec in over_limit_specs():
         if spec['use_current_state']:
-            state = planning.RobotState(np.asarray(CONFIGURATIONS[0]), np.zeros((4, 4)),
-                                        received_ns=time.time_ns())
-            snapshot = planning.Snapshot(settings, snapshot.obstacles, state)
+            state = inputs.RobotState(np.asarray(CONFIGURATIONS[0]), np.zeros((4, 4)),
+                                      received_ns=time.time_ns())
+            snapshot = inputs.Snapshot(settings, snapshot.obstacles, state)
         response = service_type().Response()
         planning.PlanSequenceHandler().handle(build_request(spec), response, snapshot,
                                               time.time_ns())
@@ -535,7 +536,7 @@ class AlternatingPublisher:
         """Create publishers in a Context of their own; start() begins publishing."""
         from geometry_msgs.msg import PoseArray
 
-        from punctured_planner.planner_node import LATCHED
+        from punctured_planner.ros.qos import LATCHED
         self.ros = RosClient('reliability_publisher')
         self.obstacles = self.ros.node.create_publisher(PoseArray, ns + '/obstacles', LATCHED)
         self.states = self.ros.node.create_publisher(PoseArray, ns + '/robot_states', 10)
@@ -666,7 +667,7 @@ def test_restart_clients_recover_and_latched_plans_come_only_after_a_new_plan(
     """SIGKILL the node, start it again: clients recover; latched paths only after a new plan."""
     from nav_msgs.msg import Path
 
-    from punctured_planner.planner_node import LATCHED
+    from punctured_planner.ros.qos import LATCHED
     ns = namespace('restart')
     first = start_node(module_dir, ns)
     handle = client.node.create_client(service_type(), ns + '/plan_sequence')

@@ -1,6 +1,18 @@
-"""Planning errors: a machine-readable code plus the culprit, Nav2 style."""
+"""
+Planning errors: a machine-readable code plus the culprits as data, Nav2 style.
 
-from collections.abc import Iterable
+A :class:`PlanningError` carries its culprits (configuration, robots,
+obstacle, coordinate) as numbers and its message as a template in which the
+configuration and obstacles are slots: ``{configuration}``, ``{obstacle}``,
+``{obstacles}``, ``{waypoint}`` and ``{next_waypoint}`` (C_{m+1} and C_{m+2}
+of ``configuration`` m). :meth:`PlanningError.describe` fills the slots with
+a :class:`Names`: the core's own (``configuration 2``, ``obstacle 1 at [0.0,
+1.0]``) for ``str()``, the ROS layer's (the request's configuration labels,
+the obstacles' positions and source) for a service response. Free text put
+into a template goes through :func:`literal`.
+"""
+
+from collections.abc import Iterable, Mapping
 import enum
 from typing import Any
 
@@ -29,27 +41,94 @@ class ErrorCode(enum.IntEnum):
     UNKNOWN = 99
 
 
+def literal(text: object) -> str:
+    """Return text with its braces doubled: free text inside a message template."""
+    return str(text).replace('{', '{{').replace('}', '}}')
+
+
+class Names:
+    """How a message names configurations and obstacles: the core's words, 0-based."""
+
+    def configuration(self, m: int) -> str:
+        """Return the name of configuration m (C_{m+1})."""
+        return f'configuration {m}'
+
+    def waypoint(self, m: int) -> str:
+        """Return the name of configuration m as a waypoint of the plan: C_{m+1}."""
+        return f'C_{m + 1}'
+
+    def obstacle(self, j: int, point: Any = None) -> str:
+        """Return the name of obstacle j, with its position when the error carries it."""
+        return f'obstacle {j}' + ('' if point is None else f' at {point}')
+
+    def obstacles(self, indices: tuple[int, ...]) -> str:
+        """Return the name of several obstacles: 'obstacles 0 and 3'."""
+        return 'obstacles ' + ' and '.join(str(j) for j in indices)
+
+
+class _Slots(Mapping):
+    """The slot values of one error's template, computed for the slots it has."""
+
+    def __init__(self, error: 'PlanningError', names: Names) -> None:
+        self._error = error
+        self._names = names
+
+    def __getitem__(self, slot: str) -> str:
+        error, names = self._error, self._names
+        if slot == 'configuration':
+            return names.configuration(int(error.configuration))  # type: ignore[arg-type]
+        if slot in ('waypoint', 'next_waypoint'):
+            m = int(error.configuration)  # type: ignore[arg-type]
+            return names.waypoint(m if slot == 'waypoint' else m + 1)
+        if slot == 'obstacle':
+            return names.obstacle(int(error.obstacle), error.point)  # type: ignore[arg-type]
+        if slot == 'obstacles':
+            return names.obstacles(error.obstacles)
+        raise KeyError(slot)
+
+    def __iter__(self):
+        return iter(('configuration', 'waypoint', 'next_waypoint', 'obstacle', 'obstacles'))
+
+    def __len__(self) -> int:
+        return 5
+
+
 class PlanningError(ValueError):
     """
     A request the planner refuses, with the configuration, robots and obstacle at fault.
 
-    Indices are 0-based: ``configuration`` is m for C_{m+1}, ``robots`` the robot
-    indices involved, ``obstacle`` the obstacle index (or None).
+    Indices are 0-based: ``configuration`` is m for C_{m+1} (for
+    CLEARANCE_BELOW_REQUIRED the segment C_{m+1} -> C_{m+2}), ``robots`` the
+    robot indices involved, ``obstacle`` the obstacle index (or None) and
+    ``obstacles`` every obstacle involved, ``coordinate`` the axis (0 for x) of
+    a faulty coordinate; ``point`` is the obstacle's position as the core
+    words it. ``message`` is the template (module docstring); ``args[0]`` and
+    ``str()`` are worded with the core's :class:`Names`.
     """
 
     def __init__(self, code: int, message: str, configuration: int | None = None,
                  robots: Iterable[int] = (), obstacle: int | None = None,
-                 clearance: Any = None, gap: Any = None) -> None:
-        """Store the code and the culprit; the message is the human-readable reason."""
-        super().__init__(message)
+                 obstacles: Iterable[int] = (), coordinate: int | None = None,
+                 point: Any = None, clearance: Any = None, gap: Any = None) -> None:
+        """Store the code and the culprits; message is the reason's template."""
         self.code = ErrorCode(code)
+        self.template = message
         self.configuration = configuration
         self.robots = tuple(int(i) for i in robots)
         self.obstacle = obstacle
+        self.obstacles = tuple(int(j) for j in obstacles) or (
+            (int(obstacle),) if obstacle is not None else ())
+        self.coordinate = coordinate
+        self.point = point
         # The refused plan's Clearance certificates, centre distance and surface gap
         # (CLEARANCE_BELOW_REQUIRED only; gap None where rounding left it untrusted).
         self.clearance = clearance
         self.gap = gap
+        super().__init__(self.describe(Names()))
+
+    def describe(self, names: Names) -> str:
+        """Return the reason with the configuration and obstacles named by names."""
+        return self.template.format_map(_Slots(self, names))
 
     def __str__(self) -> str:
         """Return the message prefixed by the code name."""

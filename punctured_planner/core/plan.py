@@ -294,13 +294,13 @@ def _check_required_clearance(result):
         limit = f'< required {required:.6g}'
     a, b = certificate.indices
     what = (f'robots {a} and {b}' if certificate.kind == 'robots'
-            else f'robot {a} and obstacle {b}')
+            else f'robot {a} and {{obstacle}}')
     segment = result.segment_of(certificate.leg)
     raise PlanningError(
         ErrorCode.CLEARANCE_BELOW_REQUIRED,
         f'{what} come within {certificate.distance:.6g} {limit} on leg '
-        f'{certificate.leg} ({result.leg_names[certificate.leg]} of segment C_{segment + 1} -> '
-        f'C_{segment + 2}) at tau {certificate.tau:.6g}',
+        f'{certificate.leg} ({result.leg_names[certificate.leg]} of segment {{waypoint}} -> '
+        f'{{next_waypoint}}) at tau {certificate.tau:.6g}',
         configuration=segment, robots=[a] if certificate.kind == 'obstacle' else [a, b],
         obstacle=b if certificate.kind == 'obstacle' else None, clearance=result.clearance,
         gap=result.gap if trusted else None)

@@ -16,7 +16,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .discs import DiscLayout
-from .errors import ErrorCode, PlanningError
+from .errors import ErrorCode, literal, PlanningError
 from .sections import VARIANTS
 from .validation import first_out_of_range, MAX_COORDINATE
 
@@ -161,13 +161,13 @@ class Workspace:
         bad = np.argwhere(~np.isfinite(obstacles))
         if bad.size:
             raise PlanningError(ErrorCode.NON_FINITE_VALUE,
-                                f'obstacle {bad[0][0]} has a non-finite coordinate',
-                                obstacle=int(bad[0][0]))
+                                '{obstacle} has a non-finite coordinate',
+                                obstacle=int(bad[0][0]), coordinate=int(bad[0][1]))
         far = first_out_of_range(obstacles)
         if far is not None:
             raise PlanningError(ErrorCode.INVALID_REQUEST,
-                                f'obstacle {far[0]} is beyond the supported range '
-                                f'+-{MAX_COORDINATE:.0e}', obstacle=far[0])
+                                f'{{obstacle}} is beyond the supported range '
+                                f'+-{MAX_COORDINATE:.0e}', obstacle=far[0], coordinate=far[1])
         self._check_options(variant, lane_spacing, min_spacing, required_clearance)
         self.obstacles = obstacles
         self.variant = variant
@@ -183,9 +183,9 @@ class Workspace:
         same = _coincident_pair(self.obstacle_projections)
         if same is not None:
             raise PlanningError(ErrorCode.OBSTACLES_DEGENERATE,
-                                f'obstacles {same[0]} and {same[1]} share one projection on '
-                                f'the frame axis e1; choose a frame that separates them',
-                                obstacle=same[0])
+                                '{obstacles} share one projection on '
+                                'the frame axis e1; choose a frame that separates them',
+                                obstacle=same[0], obstacles=same)
         self.sorted_obstacle_projections = np.sort(self.obstacle_projections)
         # Lanes must clear every obstacle: start above the highest e2 offset.
         self.lane_base = max(0.0, float(self.frame.offset(obstacles).max(initial=0.0)))
@@ -200,14 +200,15 @@ class Workspace:
         if same.size:
             a, b = sorted((int(order[same[0]]), int(order[same[0] + 1])))
             raise PlanningError(ErrorCode.OBSTACLES_DEGENERATE,
-                                f'obstacles {a} and {b} are at the same point', obstacle=a)
+                                '{obstacles} are at the same point', obstacle=a,
+                                obstacles=(a, b))
 
     @staticmethod
     def _check_options(variant, lane_spacing, min_spacing, required_clearance):
         """Raise INVALID_REQUEST for an unknown variant or a non-positive spacing."""
         if variant not in VARIANTS:
             raise PlanningError(ErrorCode.INVALID_REQUEST,
-                                f'variant must be one of {VARIANTS}, got {variant!r}')
+                                f'variant must be one of {VARIANTS}, got {literal(repr(variant))}')
         if not (np.isfinite(lane_spacing) and lane_spacing > 0):
             raise PlanningError(ErrorCode.INVALID_REQUEST, 'lane_spacing must be positive')
         if not (np.isfinite(min_spacing) and min_spacing > 0):
@@ -261,6 +262,6 @@ def _checked_radii(robot_radius, obstacle_radius, obstacle_count):
     bad = np.flatnonzero(~(np.isfinite(radii) & (radii >= 0)))
     if bad.size:
         raise PlanningError(ErrorCode.INVALID_REQUEST,
-                            f'obstacle {bad[0]}: obstacle_radius must be finite and '
+                            '{obstacle}: obstacle_radius must be finite and '
                             f'non-negative, got {radii[bad[0]]}', obstacle=int(bad[0]))
     return radius, radii

@@ -11,7 +11,7 @@ import numpy as np
 import numpy.typing as npt
 from scipy.spatial import cKDTree
 
-from .errors import ErrorCode, PlanningError
+from .errors import ErrorCode, literal, PlanningError
 from .pairs import pair_difference_matrix, point_pairs, with_obstacles
 
 # Coordinates beyond this magnitude are refused: squared distances must not
@@ -21,7 +21,7 @@ MAX_COORDINATE = 1e15
 _PAIRWISE_ROBOTS = 32
 
 
-def _real_array(item, what):
+def _real_array(item, configuration=None):
     """Return item as a float array, or raise INVALID_REQUEST if it is not real numbers."""
     try:
         array = np.asarray(item)
@@ -29,8 +29,10 @@ def _real_array(item, what):
             raise TypeError(f'elements of type {array.dtype}')
         return array.astype(float)
     except (TypeError, ValueError, OverflowError) as error:
+        what = 'the request' if configuration is None else '{configuration}'
         raise PlanningError(ErrorCode.INVALID_REQUEST,
-                            f'{what} is not an array of real numbers: {error}') from None
+                            f'{what} is not an array of real numbers: {literal(error)}',
+                            configuration=configuration) from None
 
 
 def first_out_of_range(values: np.ndarray) -> tuple[int, ...] | None:
@@ -62,9 +64,10 @@ def _reject_out_of_range(configurations, first=0):
         return False
     m, robot, axis = (0, *where) if configurations.ndim == 2 else where
     raise PlanningError(ErrorCode.INVALID_REQUEST,
-                        f'configuration {first + m}, robot {robot}: coordinate {axis} is '
+                        f'{{configuration}}, robot {robot}: coordinate {axis} is '
                         f'{configurations[where]:.6g}, beyond the supported range '
-                        f'+-{MAX_COORDINATE:.0e}', configuration=first + m, robots=[robot])
+                        f'+-{MAX_COORDINATE:.0e}', configuration=first + m, robots=[robot],
+                        coordinate=axis)
 
 
 def _as_array(configurations, dimension):
@@ -75,7 +78,7 @@ def _as_array(configurations, dimension):
     robot counts are compared (ROBOT_COUNT_MISMATCH): the smaller code wins.
     """
     if isinstance(configurations, np.ndarray) and configurations.ndim == 3:
-        configurations = _real_array(configurations, 'the request')
+        configurations = _real_array(configurations)
         if configurations.shape[0] < 2:
             raise PlanningError(ErrorCode.NO_CONFIGURATIONS,
                                 f'need at least 2 configurations, got {configurations.shape[0]}')
@@ -89,15 +92,15 @@ def _as_array(configurations, dimension):
     if len(items) < 2:
         raise PlanningError(ErrorCode.NO_CONFIGURATIONS,
                             f'need at least 2 configurations, got {len(items)}')
-    arrays = [_real_array(item, f'configuration {m}') for m, item in enumerate(items)]
+    arrays = [_real_array(item, m) for m, item in enumerate(items)]
     for m, array in enumerate(arrays):
         if array.ndim != 2 or array.shape[1] != dimension:
             raise PlanningError(ErrorCode.INVALID_REQUEST,
-                                f'configuration {m} must have shape (k, {dimension}), '
+                                f'{{configuration}} must have shape (k, {dimension}), '
                                 f'got {array.shape}', configuration=m)
     robot_count = arrays[0].shape[0]
     if robot_count == 0:
-        raise PlanningError(ErrorCode.INVALID_REQUEST, 'configuration 0 has no robots',
+        raise PlanningError(ErrorCode.INVALID_REQUEST, '{configuration} has no robots',
                             configuration=0)
     finite = True
     for m, array in enumerate(arrays):  # every one: a later range fault outranks NaN
@@ -105,7 +108,7 @@ def _as_array(configurations, dimension):
     for m, array in enumerate(arrays):
         if array.shape[0] != robot_count:
             raise PlanningError(ErrorCode.ROBOT_COUNT_MISMATCH,
-                                f'configuration {m} has {array.shape[0]} robots, '
+                                f'{{configuration}} has {array.shape[0]} robots, '
                                 f'configuration 0 has {robot_count}', configuration=m)
     return np.stack(arrays), finite
 
@@ -204,20 +207,21 @@ def validate_configurations(configurations: npt.ArrayLike, obstacles: np.ndarray
     if not all_finite:
         m, robot, axis = (int(v) for v in np.argwhere(~np.isfinite(checked))[0])
         raise PlanningError(ErrorCode.NON_FINITE_VALUE,
-                            f'configuration {m}, robot {robot}: coordinate {axis} is '
-                            f'{checked[m, robot, axis]}', configuration=m, robots=[robot])
+                            f'{{configuration}}, robot {robot}: coordinate {axis} is '
+                            f'{checked[m, robot, axis]}', configuration=m, robots=[robot],
+                            coordinate=axis)
     coincident, on_obstacle = _coincidences(checked, obstacles)
     if coincident is not None:
         m, a, b = coincident
         raise PlanningError(ErrorCode.ROBOTS_COINCIDE,
-                            f'configuration {m}: robots {a} and {b} are at the same point '
+                            f'{{configuration}}: robots {a} and {b} are at the same point '
                             f'{checked[m, a].tolist()}', configuration=m, robots=[a, b])
     if on_obstacle is not None:
         m, robot, obstacle = on_obstacle
         raise PlanningError(ErrorCode.ROBOT_ON_OBSTACLE,
-                            f'configuration {m}: robot {robot} is on obstacle {obstacle} '
-                            f'at {obstacles[obstacle].tolist()}', configuration=m,
-                            robots=[robot], obstacle=obstacle)
+                            f'{{configuration}}: robot {robot} is on {{obstacle}}',
+                            configuration=m, robots=[robot], obstacle=obstacle,
+                            point=obstacles[obstacle].tolist())
     if obstacle_radii is None:
         obstacle_radii = np.zeros(len(obstacles))
     overlap, on_obstacle = _first_overlap(checked, obstacles, robot_radius,
@@ -225,15 +229,16 @@ def validate_configurations(configurations: npt.ArrayLike, obstacles: np.ndarray
     if overlap is not None:
         m, a, b, distance = overlap
         raise PlanningError(ErrorCode.ROBOTS_COINCIDE,
-                            f'configuration {m}: the discs of robots {a} and {b} overlap: '
+                            f'{{configuration}}: the discs of robots {a} and {b} overlap: '
                             f'centres {distance:.6g} apart, less than 2 robot_radius = '
                             f'{2 * robot_radius:.6g}', configuration=m, robots=[a, b])
     if on_obstacle is not None:
         m, robot, obstacle, distance = on_obstacle
         raise PlanningError(ErrorCode.ROBOT_ON_OBSTACLE,
-                            f'configuration {m}: robot {robot} overlaps obstacle {obstacle} '
-                            f'at {obstacles[obstacle].tolist()}: centres {distance:.6g} '
+                            f'{{configuration}}: robot {robot} overlaps {{obstacle}}: '
+                            f'centres {distance:.6g} '
                             f'apart, less than robot_radius + obstacle_radius = '
                             f'{robot_radius + obstacle_radii[obstacle]:.6g}',
-                            configuration=m, robots=[robot], obstacle=obstacle)
+                            configuration=m, robots=[robot], obstacle=obstacle,
+                            point=obstacles[obstacle].tolist())
     return checked

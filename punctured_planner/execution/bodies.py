@@ -43,7 +43,7 @@ class Bodies:
     obstacles: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     obstacle_radii: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
-    def pair_gaps(self, start: np.ndarray, end: np.ndarray = None) -> tuple:
+    def pair_gaps(self, start: np.ndarray, end: np.ndarray | None = None) -> tuple:
         """
         Return (gaps, a, b): every pair's smallest surface gap while moving start -> end.
 
@@ -66,7 +66,7 @@ class Bodies:
                                 np.asarray(self.obstacle_radii, dtype=float)])
         return np.sqrt(squared) - radii[a] - radii[b], a, b
 
-    def smallest_gap(self, start: np.ndarray, end: np.ndarray = None) -> Gap:
+    def smallest_gap(self, start: np.ndarray, end: np.ndarray | None = None) -> Gap:
         """Return the smallest surface Gap while moving start -> end (inf: nothing to meet)."""
         gaps, a, b = self.pair_gaps(start, end)
         if gaps.size == 0:

@@ -65,7 +65,7 @@ class Execution:
     """The state of one plan's execution: its clock, the largest errors and the smallest gap."""
 
     def __init__(self, reference: Reference, tolerance: float, settings: ExecutionSettings,
-                 bodies: Bodies = None):
+                 bodies: Bodies | None = None):
         """Start at plan time 0 with no error measured yet."""
         self.reference = reference
         self.tolerance = float(tolerance)

@@ -29,8 +29,8 @@ class FleetSettings:
 
     bodies: Bodies = field(default_factory=Bodies)
     speed_limit: float = 1.0
-    speed_factors: np.ndarray = None   # (k,), None: all 1
-    latencies: np.ndarray = None       # (k,) seconds, None: all 0
+    speed_factors: np.ndarray | None = None   # (k,), None: all 1
+    latencies: np.ndarray | None = None       # (k,) seconds, None: all 0
     velocity_noise: float = 0.0
     command_timeout: float = 0.5
     seed: int = 0
@@ -56,7 +56,7 @@ class Fleet:
         k = len(self.positions)
         self.configure(settings)
         self.velocities = np.zeros((k, 3))
-        self._pending = [deque() for _ in range(k)]  # (apply_time, velocity)
+        self._pending: list[deque] = [deque() for _ in range(k)]  # (apply_time, velocity)
         self._active = np.zeros((k, 3))
         self._active_since = np.full(k, -np.inf)
         self._rng = np.random.default_rng(settings.seed)

@@ -112,6 +112,19 @@ def _grab(figure):
     return Image.fromarray(np.asarray(figure.canvas.buffer_rgba())[..., :3].copy())
 
 
+def _static_background(figure, dynamic):
+    """Return the figure drawn without its dynamic artists: what every frame starts from."""
+    figure.canvas.draw()
+    figure.set_layout_engine('none')
+    for artist in dynamic:
+        artist.set_visible(False)
+    figure.canvas.draw()
+    background = figure.canvas.copy_from_bbox(figure.bbox)
+    for artist in dynamic:
+        artist.set_visible(True)
+    return background
+
+
 def render_animation(plan, path, fps=20, seconds=8.0, dpi=80, title=None, max_speed=1.0):
     """
     Write the motion as an animated GIF at path (about fps * seconds frames); return path.
@@ -143,14 +156,7 @@ def render_animation(plan, path, fps=20, seconds=8.0, dpi=80, title=None, max_sp
                    plane_view(plan)(positions)))
     dynamic = [heading_text] + [artist for mover, _ in movers
                                 for artist in mover.trails + mover.robots + mover.bodies]
-    figure.canvas.draw()
-    figure.set_layout_engine('none')
-    for artist in dynamic:
-        artist.set_visible(False)
-    figure.canvas.draw()
-    background = figure.canvas.copy_from_bbox(figure.bbox)
-    for artist in dynamic:
-        artist.set_visible(True)
+    background = _static_background(figure, dynamic)
     frames = []
     for frame in range(tau.size):
         figure.canvas.restore_region(background)

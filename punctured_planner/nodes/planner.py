@@ -3,9 +3,9 @@ The planner node: topics and parameters in, PlanSequence service, a Path per rob
 
 A thin adapter: it keeps the latest obstacles, robot state and parameters under
 one lock, takes one snapshot of them per request (logged with its stamps),
-hands request and snapshot to :class:`punctured_planner.planning.PlanSequenceHandler` (the
-checks and the core) and publishes the result. No math here; every message
-conversion is in :mod:`punctured_planner.conversions`.
+hands request and snapshot to :class:`punctured_planner.ros.planning.PlanSequenceHandler`
+(the checks and the core) and publishes the result. No math here; every message
+conversion is in :mod:`punctured_planner.ros.conversions`.
 
 Obstacle rule: the latest of the two sources is the obstacle set. At start it
 is the ``obstacles`` parameter; a message on the ``obstacles`` topic replaces
@@ -26,10 +26,9 @@ obstacles and robot states at 50 Hz, service round trips went from 4 ms to 80
 ms median with stalls of 2-6 s (two single-threaded executors: 3.4 ms, worst 6
 ms). A plan is published only once it is complete. Start and stop (Ctrl-C and
 SIGTERM alike, threads joined before anything is destroyed):
-:func:`punctured_planner.shutdown.run_nodes`.
+:func:`punctured_planner.ros.runtime.run_nodes`.
 """
 
-from dataclasses import dataclass
 import sys
 import threading
 import traceback
@@ -37,53 +36,29 @@ import traceback
 from geometry_msgs.msg import PoseArray
 from nav_msgs.msg import Odometry
 from nav_msgs.msg import Path
-import numpy as np
 from punctured_planner_interfaces.msg import Plan
 from punctured_planner_interfaces.srv import PlanSequence
-from rcl_interfaces.msg import SetParametersResult
-from rclpy.exceptions import ParameterException
 from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy
-from rclpy.qos import HistoryPolicy
-from rclpy.qos import QoSProfile
-from rclpy.qos import ReliabilityPolicy
 from std_msgs.msg import UInt32
 from visualization_msgs.msg import MarkerArray
 
-from . import conversions
-from . import publications
-from .core import PlanningError
-from .parameters import descriptor
-from .parameters import NODE_NAME
-from .parameters import node_values
-from .parameters import PARAMETERS
-from .parameters import settings_from_values
-from .parameters import SPECS
-from .planning import ObstacleSet
-from .planning import PlanSequenceHandler
-from .planning import RobotState
-from .planning import Snapshot
-from .shutdown import run_nodes
-
-
-@dataclass(frozen=True, eq=False)
-class OdometryEntry:
-    """The last odometry of one robot: pose, frame, stamp and arrival time (node clock)."""
-
-    position: np.ndarray
-    orientation: np.ndarray
-    frame_id: str
-    stamp_ns: int
-    received_ns: int
-
-
-LATCHED = QoSProfile(depth=1, history=HistoryPolicy.KEEP_LAST,
-                     reliability=ReliabilityPolicy.RELIABLE,
-                     durability=DurabilityPolicy.TRANSIENT_LOCAL)
-# Robot state streams: best effort matches reliable and best-effort publishers alike.
-STATE = QoSProfile(depth=1, history=HistoryPolicy.KEEP_LAST,
-                   reliability=ReliabilityPolicy.BEST_EFFORT,
-                   durability=DurabilityPolicy.VOLATILE)
+from ..core import PlanningError
+from ..ros import conversions
+from ..ros import publications
+from ..ros.parameters import NodeParameters
+from ..ros.planning import PlanSequenceHandler
+from ..ros.qos import LATCHED
+from ..ros.qos import STATE
+from ..ros.runtime import NodeGroup
+from ..ros.runtime import run_nodes
+from ..ros.settings import PLANNER
+from ..ros.settings import PlannerSettings
+from ..ros.snapshot import ObstacleSet
+from ..ros.snapshot import RobotOdometry
+from ..ros.snapshot import RobotState
+from ..ros.snapshot import Snapshot
+from ..ros.snapshot import take_snapshot
+from ..ros.wording import ObstacleNames
 
 
 class PlannerNode(Node):
@@ -91,19 +66,17 @@ class PlannerNode(Node):
 
     def __init__(self, **kwargs):
         """Declare the parameters, subscribe, advertise; raise ValueError for bad parameters."""
-        super().__init__(NODE_NAME, **kwargs)
+        super().__init__(PLANNER.node_name, **kwargs)
         self._lock = threading.Lock()
         self._handler = PlanSequenceHandler()
         self._request_count = 0
         self._plan_count = 0
-        for spec in PARAMETERS:
-            self.declare_parameter(spec.name, spec.default, descriptor(spec))
-        self._settings = settings_from_values(node_values(self, SPECS))
-        self.add_on_set_parameters_callback(self._on_set_parameters)
-        self.add_post_set_parameters_callback(self._after_set_parameters)
-        self._obstacles = self._parameter_obstacles(self._settings)
         self._robot_states: RobotState | None = None
-        self._odometry: dict[str, OdometryEntry] = {}
+        self._odometry: dict[str, RobotOdometry] = {}
+        self._obstacles: ObstacleSet | None = None
+        self._node_parameters = NodeParameters(self, PLANNER, self._apply_parameters)
+        self._settings: PlannerSettings = self._node_parameters.settings
+        self._obstacles = self._parameter_obstacles(self._settings)
 
         # The subscriptions' own node: spun apart from the service (module docstring).
         # A local __node remap outranks a global one (-r __node:=NAME, launch name=).
@@ -132,24 +105,8 @@ class PlannerNode(Node):
 
     # ------------------------------------------------------------ parameters
 
-    def _on_set_parameters(self, parameters):
-        """Refuse a change that makes the settings invalid, with the reason."""
-        try:
-            settings_from_values(node_values(self, SPECS, parameters))
-        except ValueError as error:
-            return SetParametersResult(successful=False, reason=str(error))
-        return SetParametersResult(successful=True)
-
-    def _after_set_parameters(self, parameters):
-        """Take the accepted values into the settings the next request will use."""
-        try:
-            self._apply_parameters(parameters)
-        except Exception as error:  # a parameter change never stops the node
-            self.get_logger().error('applying parameters failed: %r' % error)
-
-    def _apply_parameters(self, parameters):
-        changed = {p.name for p in parameters}
-        settings = settings_from_values(node_values(self, SPECS))
+    def _apply_parameters(self, settings, changed):
+        """Post-set: the settings, and obstacles and odometry where their parameters changed."""
         with self._lock:
             self._settings = settings
             if 'obstacles' in changed:
@@ -159,8 +116,6 @@ class PlannerNode(Node):
                                   if name in settings.robot_names}
         if 'robot_names' in changed:
             self._update_odometry_subscriptions(settings.robot_names)
-        self.get_logger().info('parameters set: %s' % ', '.join(
-            '%s=%r' % (p.name, p.value) for p in parameters))
 
     def _parameter_obstacles(self, settings):
         return ObstacleSet(conversions.obstacles_from_parameter(settings.obstacles),
@@ -190,8 +145,9 @@ class PlannerNode(Node):
         try:
             self._handler.check_obstacles(settings, obstacles)
         except PlanningError as error:
-            self.get_logger().warning('refused %s: %s; keeping %s' % (
-                obstacles.describe(), error, previous.describe()))
+            self.get_logger().warning('refused %s: %s: %s; keeping %s' % (
+                obstacles.describe(), error.code.name,
+                error.describe(ObstacleNames(obstacles)), previous.describe()))
             return
         with self._lock:
             self._obstacles = obstacles
@@ -206,44 +162,17 @@ class PlannerNode(Node):
             self._robot_states = state
 
     def _on_odometry(self, name, msg):
-        position, orientation = conversions.odometry_pose(msg)
-        entry = OdometryEntry(position, orientation, msg.header.frame_id,
-                              conversions.stamp_to_ns(msg.header.stamp),
-                              self.get_clock().now().nanoseconds)
+        entry = conversions.robot_odometry(msg, self.get_clock().now().nanoseconds)
         with self._lock:
             # A late message for a robot just removed from robot_names is dropped.
             if name in self._settings.robot_names:
                 self._odometry[name] = entry
 
-    def _current_state(self, settings):
-        """Return (RobotState or None, why none); call with the lock held."""
-        candidates = []
-        if self._robot_states is not None:
-            candidates.append(self._robot_states)
-        names = settings.robot_names
-        missing = [name for name in names if name not in self._odometry]
-        if names and not missing:
-            entries = [self._odometry[name] for name in names]
-            frames = [e.frame_id for e in entries]
-            frame = next((f for f in frames if f and f != settings.frame_id), frames[0])
-            candidates.append(RobotState(
-                np.stack([e.position for e in entries]),
-                np.stack([e.orientation for e in entries]), frame,
-                min(e.stamp_ns for e in entries), 'odometry of %s' % ', '.join(names),
-                min(e.received_ns for e in entries)))
-        if candidates:
-            return max(candidates, key=lambda state: state.received_ns), ''
-        problem = 'no robot state received yet (topic robot_states'
-        if names:
-            problem += ', or odometry from %s' % ', '.join(n + '/odom' for n in missing)
-        return None, problem + ')'
-
-    def snapshot(self):
+    def snapshot(self) -> Snapshot:
         """Return one consistent Snapshot of parameters, obstacles and robot state."""
         with self._lock:
-            settings = self._settings
-            state, problem = self._current_state(settings)
-            return Snapshot(settings, self._obstacles, state, problem)
+            return take_snapshot(self._settings, self._obstacles, self._robot_states,
+                                 dict(self._odometry))
 
     # ------------------------------------------------------------ the service
 
@@ -314,19 +243,15 @@ class PlannerNode(Node):
         return publisher
 
 
-def planner_nodes(context=None, **kwargs):
-    """Return [PlannerNode, its inputs node]: the nodes to spin, each in its own thread."""
+def planner_nodes(context=None, **kwargs) -> NodeGroup:
+    """Return the PlannerNode and its inputs node: each spun in its own thread."""
     node = PlannerNode(context=context, **kwargs)
-    return [node, node.inputs]
+    return NodeGroup([node, node.inputs])
 
 
 def main(args=None):
     """Run the node until Ctrl-C or SIGTERM; return 0, or 2 for invalid parameters."""
-    try:
-        return run_nodes(planner_nodes, args=args)
-    except (ValueError, ParameterException) as error:
-        print('planner_node: invalid parameters: %s' % error, file=sys.stderr)
-        return 2
+    return run_nodes(PLANNER.node_name, planner_nodes, args=args)
 
 
 if __name__ == '__main__':

@@ -1,19 +1,22 @@
 """
-Spin rclpy nodes in threads and stop them cleanly on SIGINT or SIGTERM.
+The node runtime: start, spin and stop every node process of the package the same way.
 
-Every node process of this package runs through :func:`run_nodes`, so each
-stops the same way: exit code 0, no traceback, no thread left spinning, on
-Ctrl-C and on SIGTERM alike, also in the middle of a callback (the callback
-finishes, a service response goes out, then the process stops).
+``planner_node``, ``plan_executor`` and ``fleet_sim`` all run through
+:func:`run_nodes`, so each starts, spins and stops alike: exit code 0, no
+traceback, no thread left spinning, on Ctrl-C and on SIGTERM alike, also in
+the middle of a callback (the callback finishes, a service response goes
+out, then the process stops); exit code 2 with the reason for invalid
+parameters; 1 when a callback raised.
 
 Use::
 
-    from punctured_planner.shutdown import run_nodes
+    from punctured_planner.ros.runtime import NodeGroup, run_nodes
 
     def main(args=None):
-        return run_nodes(lambda context: [MyNode(context=context)], args=args)
+        return run_nodes('my_node', lambda context: NodeGroup([MyNode(context=context)]),
+                         args=args)
 
-``make_nodes(context)`` returns the nodes to spin; each gets its own
+``make_nodes(context)`` returns the :class:`NodeGroup` to spin; each node gets its own
 SingleThreadedExecutor in its own thread, so a slow callback on one node never
 blocks another (give subscriptions their own node for that). In tests, or
 wherever the process's signals belong to someone else, spin nodes with
@@ -37,8 +40,11 @@ hung now and then, and segfaulted about once in 26 stops. Here instead:
    ``Executor.spin``.
 3. On the signal: the stop flag is set and every executor woken; each thread
    finishes its callback in flight and returns; the threads are joined. Only
-   then are the executors shut down, the nodes destroyed (in reverse order)
-   and the Context shut down.
+   then are the executors shut down, the group's ``before_teardown`` hook run
+   (the executor leaves its robots stopped), the nodes destroyed (in reverse
+   order) and the Context shut down: :func:`_teardown`, the one place every
+   step after the spinning lives (a later "deliver the replies in flight
+   before the participant goes" step goes there too).
 
 A callback that raises stops the process the same way, with the traceback
 logged and exit code 1. A callback still running ``timeout_sec`` after the
@@ -47,6 +53,7 @@ stuck and ends the process with ``os._exit(1)`` rather than destroy what a
 thread still uses.
 """
 
+from dataclasses import dataclass
 import os
 import signal
 import sys
@@ -59,6 +66,7 @@ from typing import Sequence
 
 import rclpy
 from rclpy.context import Context
+from rclpy.exceptions import ParameterException
 from rclpy.executors import ConditionReachedException
 from rclpy.executors import ExternalShutdownException
 from rclpy.executors import ShutdownException
@@ -71,6 +79,11 @@ STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 STOP_TIMEOUT_SEC = 30.0
 EXIT_OK = 0
 EXIT_FAILED = 1
+EXIT_BAD_PARAMETERS = 2
+# What a node's constructor raises for invalid parameters: the package's own checks
+# (ValueError with the reason) and rclpy's (a value outside a descriptor's range,
+# a value of the wrong type).
+BAD_PARAMETERS = (ValueError, ParameterException)
 _WOKEN = 0  # the byte wake() writes: not a signal number
 
 
@@ -86,7 +99,7 @@ class StopSignals:
     def __init__(self, signals: Sequence[int] = STOP_SIGNALS):
         """Remember which signals to take over; nothing changes before ``__enter__``."""
         self._signals = tuple(signals)
-        self._previous = {}
+        self._previous: dict = {}
         self._previous_fd = -1
         self._read_fd = self._write_fd = -1
 
@@ -124,6 +137,19 @@ class StopSignals:
 
 def _ignore(number, frame):
     """Signal handler: nothing to do, the wake-up fd has woken StopSignals.wait."""
+
+
+@dataclass
+class NodeGroup:
+    """
+    The nodes of one process and what must happen before they are destroyed.
+
+    ``before_teardown`` runs once the executors stopped and before any node
+    is destroyed: publishers still work, no callback runs any more.
+    """
+
+    nodes: Sequence[Node]
+    before_teardown: Optional[Callable[[], None]] = None
 
 
 class ExecutorThreads:
@@ -201,41 +227,64 @@ class ExecutorThreads:
         return [node.get_fully_qualified_name()
                 for node, thread in zip(self.nodes, self._threads) if thread.is_alive()]
 
-    def close(self, timeout_sec: float = STOP_TIMEOUT_SEC) -> bool:
-        """stop(), then destroy the nodes in reverse order; return False if stop() failed."""
+    def close(self, timeout_sec: float = STOP_TIMEOUT_SEC,
+              before_teardown: Optional[Callable[[], None]] = None) -> bool:
+        """
+        stop(), run before_teardown, destroy the nodes in reverse order.
+
+        Return False (and leave everything as it is) if stop() failed.
+        """
         if not self.stop(timeout_sec):
             return False
+        if before_teardown is not None:
+            before_teardown()
         for node in reversed(self.nodes):
             node.destroy_node()
         return True
 
 
-def run_nodes(make_nodes: Callable[[Context], Sequence[Node]], args: Optional[List[str]] = None,
-              timeout_sec: float = STOP_TIMEOUT_SEC) -> int:
+def run_nodes(name: str, make_nodes: Callable[[Context], NodeGroup],
+              args: Optional[List[str]] = None, timeout_sec: float = STOP_TIMEOUT_SEC) -> int:
     """
-    Run nodes until SIGINT or SIGTERM, stop them cleanly; return the process's exit code.
+    Run a process's nodes until SIGINT or SIGTERM, stop them cleanly; return the exit code.
 
     The whole ``main()`` of a node process (see the module docstring):
     initialise a Context with ``args``, call ``make_nodes(context)``, spin each
     node in its thread, wait for a stop signal, stop. Returns 0 after a
-    signal, 1 when a callback raised. An exception of ``make_nodes`` (e.g.
-    invalid parameters) propagates, after the Context is shut down. Call it
-    from the main thread.
+    signal, 1 when a callback raised, 2 (with the reason on stderr, after
+    ``name: invalid parameters:``) when ``make_nodes`` refused its parameters.
+    Call it from the main thread.
     """
     with StopSignals() as signals:
         context = Context()
         rclpy.init(args=args, context=context, signal_handler_options=SignalHandlerOptions.NO)
         try:
-            threads = ExecutorThreads(make_nodes(context), context, on_failure=signals.wake)
+            try:
+                group = make_nodes(context)
+            except BAD_PARAMETERS as error:
+                print('%s: invalid parameters: %s' % (name, error), file=sys.stderr)
+                return EXIT_BAD_PARAMETERS
+            threads = ExecutorThreads(group.nodes, context, on_failure=signals.wake)
             threads.start()
             signals.wait()
-            if not threads.close(timeout_sec):
-                threads.nodes[0].get_logger().fatal(
-                    'callbacks of %s still running %.0f s after the stop signal; exiting '
-                    'without cleanup' % (', '.join(threads.stuck()), timeout_sec))
-                sys.stdout.flush()
-                sys.stderr.flush()
-                os._exit(EXIT_FAILED)
+            _teardown(threads, group, timeout_sec)
         finally:
             rclpy.try_shutdown(context=context)
     return EXIT_FAILED if threads.failure is not None else EXIT_OK
+
+
+def _teardown(threads: ExecutorThreads, group: NodeGroup, timeout_sec: float) -> None:
+    """
+    Every step after the stop signal, in order: stop spinning, the hook, destroy the nodes.
+
+    A callback still running ``timeout_sec`` after the signal cannot be
+    stopped from Python: the stuck nodes are logged and the process ends with
+    ``os._exit(1)`` rather than destroy what a thread still uses.
+    """
+    if not threads.close(timeout_sec, group.before_teardown):
+        threads.nodes[0].get_logger().fatal(
+            'callbacks of %s still running %.0f s after the stop signal; exiting '
+            'without cleanup' % (', '.join(threads.stuck()), timeout_sec))
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(EXIT_FAILED)

@@ -112,7 +112,7 @@ def write_mcap(path, messages, log_time_ns, metadata=None):
     Write [(topic, message)] to an MCAP file at ``path``; return the path.
 
     A message is a ROS message, serialised by rclpy (exact CDR), or a
-    :class:`punctured_planner.publications.Publication` (recorded as the node
+    :class:`punctured_planner.ros.publications.Publication` (recorded as the node
     publishes it, perhaps bytes already). Each is logged at
     ``log_time_ns``: one time for all, or a sequence with one per message;
     metadata (dict of str) goes into a ``punctured_planner`` metadata record.

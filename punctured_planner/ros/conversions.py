@@ -3,8 +3,9 @@ Every conversion between ROS messages and the core's numpy arrays, in one place.
 
 The node, the ``punctured-planner`` command and the MCAP writer all use these
 functions, so a plan looks the same on a topic, in a service response and in
-a recording. The RViz markers and the list of published messages are in
-:mod:`punctured_planner.publications`.
+a recording; the nodes fill every message they publish with the builders
+here. The RViz markers are in :mod:`punctured_planner.ros.markers`, the list
+of published messages in :mod:`punctured_planner.ros.publications`.
 
 Conventions:
 
@@ -30,14 +31,21 @@ from geometry_msgs.msg import Point
 from geometry_msgs.msg import Pose
 from geometry_msgs.msg import PoseStamped
 from geometry_msgs.msg import Quaternion
+from geometry_msgs.msg import Twist
+from geometry_msgs.msg import Vector3
+from nav_msgs.msg import Odometry
 from nav_msgs.msg import Path
 import numpy as np
+from punctured_planner_interfaces.msg import Plan  # type: ignore[attr-defined]
 from std_msgs.msg import Header
 from std_msgs.msg import UInt32
 
-from .execution import Bodies
-from .execution import Reference
-from .execution import tracking_tolerance
+from .cdr import serialized_paths
+from .goals import KnownPlan
+from .snapshot import RobotOdometry
+from ..execution import Bodies
+from ..execution import Reference
+from ..execution import tracking_tolerance
 
 IDENTITY = (0.0, 0.0, 0.0, 1.0)
 
@@ -62,6 +70,13 @@ def odometry_pose(msg):
     return (np.array([pose.position.x, pose.position.y, pose.position.z], dtype=float),
             np.array([pose.orientation.x, pose.orientation.y, pose.orientation.z,
                       pose.orientation.w], dtype=float))
+
+
+def robot_odometry(msg, received_ns):
+    """Return the RobotOdometry of a nav_msgs/Odometry message that arrived at received_ns."""
+    position, orientation = odometry_pose(msg)
+    return RobotOdometry(position, orientation, msg.header.frame_id,
+                         stamp_to_ns(msg.header.stamp), int(received_ns))
 
 
 def obstacles_from_parameter(values):
@@ -190,7 +205,7 @@ def plan_to_paths(samples, orientations, frame_id, start_ns, plane_z=0.0):
     held = [[_filled(Quaternion, x=qx, y=qy, z=qz, w=qw) for qx, qy, qz, qw in robot]
             for robot in quaternions.tolist()]
     paths = Paths()
-    paths.serialized = _serialized_paths(frame_id, start_ns, stamps, np.concatenate(
+    paths.serialized = serialized_paths(frame_id, start_ns, stamps, np.concatenate(
         [xyz, quaternions[:, waypoint]], axis=-1))
     new = object.__new__
     for robot_xyz, robot_held in zip(xyz.tolist(), held):
@@ -209,52 +224,40 @@ def plan_to_paths(samples, orientations, frame_id, start_ns, plane_z=0.0):
     return paths
 
 
-# CDR as rmw_fastrtps writes it: encapsulation header (little endian), then the fields,
-# each aligned to its size counted from the end of the header.
-_CDR_HEADER = b'\x00\x01\x00\x00'
+def header(frame_id, stamp_ns):
+    """Return a std_msgs/Header in frame_id at integer nanoseconds."""
+    return Header(frame_id=frame_id, stamp=time_from_ns(stamp_ns))
 
 
-def _align(offset, size):
-    return -(-offset // size) * size
+def pose(position, orientation=IDENTITY):
+    """Return a geometry_msgs/Pose at position (3,) with orientation (x, y, z, w)."""
+    x, y, z = np.asarray(position, dtype=float).tolist()
+    qx, qy, qz, qw = np.asarray(orientation, dtype=float).tolist()
+    return Pose(position=Point(x=x, y=y, z=z), orientation=Quaternion(x=qx, y=qy, z=qz, w=qw))
 
 
-def _stamped_pose_dtype(frame, start):
-    """Return the numpy layout of a geometry_msgs/PoseStamped in frame ``frame`` at ``start``."""
-    pose = _align(start + 13 + len(frame), 8) - start  # stamp, string (length, bytes, NUL)
-    return np.dtype({'names': ['sec', 'nanosec', 'length', 'frame', 'pose'],
-                     'formats': ['<i4', '<u4', '<u4', 'S%d' % (len(frame) + 1), ('<f8', 7)],
-                     'offsets': [0, 4, 8, 12, pose], 'itemsize': pose + 56})
+def pose_stamped(stamp_header, position, orientation=IDENTITY):
+    """Return a geometry_msgs/PoseStamped with a shared Header."""
+    return PoseStamped(header=stamp_header, pose=pose(position, orientation))
 
 
-def _serialized_paths(frame_id, start_ns, stamps, values):
-    """
-    Return nav_msgs/Paths serialised, built with numpy: one per row of values (k, M, 7).
+def vector3(values):
+    """Return a geometry_msgs/Vector3 of a (3,) array."""
+    x, y, z = np.asarray(values, dtype=float).tolist()
+    return Vector3(x=x, y=y, z=z)
 
-    The bytes ``rclpy.serialization.serialize_message`` gives for the Paths of
-    :func:`plan_to_paths` (padding zeroed): header stamp start_ns, poses stamped
-    ``stamps`` (M,) ns in frame_id, with positions and orientations ``values``.
-    """
-    frame = frame_id.encode()
-    robots, count = values.shape[:2]
-    first = _align(13 + len(frame), 4) + 4  # header, then the sequence length
-    head = _stamped_pose_dtype(frame, first)
-    rest = _stamped_pose_dtype(frame, 0)  # a pose ends 8-aligned: the rest repeat
-    size = first + (head.itemsize + (count - 1) * rest.itemsize if count else 0)
-    body = np.zeros((robots, size), dtype=np.uint8)
-    stamp = time_from_ns(start_ns)
-    body[:, :12].view('<u4')[:] = (stamp.sec, stamp.nanosec, len(frame) + 1)
-    body[:, 12:12 + len(frame)] = np.frombuffer(frame, dtype=np.uint8)
-    body[:, first - 4:first].view('<u4')[:] = count
-    for dtype, start, select in ((head, first, slice(0, 1)),
-                                 (rest, first + head.itemsize, slice(1, None))):
-        elements = np.zeros((robots, len(stamps[select])), dtype=dtype)
-        elements['sec'], elements['nanosec'] = divmod(stamps[select], 1000000000)
-        elements['length'] = len(frame) + 1
-        elements['frame'] = frame
-        elements['pose'] = values[:, select]
-        body[:, start:start + elements.shape[1] * dtype.itemsize] = elements.view(
-            np.uint8).reshape(robots, -1)
-    return [_CDR_HEADER + row.tobytes() for row in body]
+
+def twist(linear=(0.0, 0.0, 0.0)):
+    """Return a geometry_msgs/Twist of linear velocity (3,), no rotation: zero by default."""
+    return Twist(linear=vector3(linear))
+
+
+def odometry(stamp_header, child_frame_id, position, velocity):
+    """Return a nav_msgs/Odometry: position (3,) with the identity orientation, velocity (3,)."""
+    message = Odometry(header=stamp_header, child_frame_id=child_frame_id)
+    message.pose.pose = pose(position)
+    message.twist.twist = twist(velocity)
+    return message
 
 
 def domain_index_message(plan):
@@ -322,7 +325,6 @@ def plan_message(outcome, settings):
     The bodies are the workspace's (robot radius, obstacles and their radii); the
     tracking tolerance is execution.tracking_tolerance(min_gap).
     """
-    from punctured_planner_interfaces.msg import Plan
     workspace = outcome.plan.workspace
     obstacles = [Point(x=x, y=y, z=z) for x, y, z in
                  to_xyz(workspace.obstacles, settings.plane_z).reshape(-1, 3).tolist()]
@@ -369,3 +371,11 @@ def plan_bodies(msg):
     obstacles = np.array([(p.x, p.y, p.z) for p in msg.obstacles], dtype=float).reshape(-1, 3)
     return Bodies(float(msg.robot_radius), obstacles,
                   np.asarray(msg.obstacle_radii, dtype=float).reshape(-1))
+
+
+def known_plan(msg):
+    """Return the KnownPlan of a Plan message; raise ValueError for a plan without one clock."""
+    reference = plan_reference(msg)
+    return KnownPlan(int(msg.plan_id), tuple(msg.robot_names), msg.paths[0].header.frame_id,
+                     reference, plan_bodies(msg), float(msg.min_gap),
+                     float(msg.tracking_tolerance))

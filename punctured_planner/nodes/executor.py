@@ -1,0 +1,303 @@
+"""
+The plan_executor node: executes a published plan in lockstep over DDS.
+
+A thin adapter around :class:`punctured_planner.execution.Execution`: it keeps
+the plans it hears on ``plan`` (latched; :class:`punctured_planner.ros.goals.PlanStore`),
+each robot's latest ``<robot>/odom``, and serves the ``execute_plan`` action
+(ExecutePlan). A control timer at ``control_rate`` runs one Execution step for
+the active goal and publishes ``<robot>/cmd_vel`` (mode ``velocity``;
+geometry_msgs/Twist in the robot's body frame, rotated from the planning frame
+by its odometry orientation) and ``<robot>/reference_pose`` (PoseStamped at
+the shared clock, both modes).
+
+Goal life: the plan is looked up (``NO_PLAN``), its tolerance checked
+(``UNSAFE_PLAN``); the executor then waits up to ``discovery_timeout`` for
+fresh odometry of every robot (``UNKNOWN_ROBOTS``) in the plan's frame
+(``FRAME_MISMATCH``); then it runs until every robot has arrived (``NONE``),
+a cancel (``CANCELED``: every robot is sent zero velocity from the cancel
+callback itself, without waiting for the next tick), a newer goal
+(``PREEMPTED``) or odometry in another frame (``FRAME_MISMATCH``). Stale
+odometry never ends a goal: the clock holds until the robot is back.
+Everything runs on one single-threaded executor, so callbacks never overlap.
+On Ctrl-C or SIGTERM the runtime's ``before_teardown`` hook sends zero
+velocity to the robots of the active goal before the node goes.
+"""
+
+from dataclasses import dataclass
+from dataclasses import field
+import sys
+from typing import Any
+
+from geometry_msgs.msg import PoseStamped
+from geometry_msgs.msg import Twist
+from nav_msgs.msg import Odometry
+from punctured_planner_interfaces.action import ExecutePlan
+from punctured_planner_interfaces.msg import Plan
+from rclpy.action import ActionServer
+from rclpy.action import CancelResponse
+from rclpy.action import GoalResponse
+from rclpy.node import Node
+from rclpy.publisher import Publisher
+from rclpy.subscription import Subscription
+from rclpy.task import Future
+from scipy.spatial.transform import Rotation
+
+from ..execution import Execution
+from ..ros import conversions
+from ..ros.goals import fleet_state
+from ..ros.goals import FleetState
+from ..ros.goals import KnownPlan
+from ..ros.goals import PlanStore
+from ..ros.parameters import NodeParameters
+from ..ros.qos import COMMANDS
+from ..ros.qos import LATCHED
+from ..ros.qos import STATE
+from ..ros.runtime import NodeGroup
+from ..ros.runtime import run_nodes
+from ..ros.settings import EXECUTOR
+from ..ros.settings import ExecutorSettings
+from ..ros.snapshot import RobotOdometry
+
+Result = ExecutePlan.Result
+
+
+@dataclass
+class Run:
+    """The active goal: its plan, its Execution once started, and how it ended."""
+
+    goal: Any
+    plan: KnownPlan
+    requested_ns: int
+    done: Future = field(default_factory=Future)
+    execution: Execution | None = None
+    started_ns: int = 0
+    last_ns: int = 0
+    stale: tuple = ()
+
+
+@dataclass(frozen=True)
+class RobotLink:
+    """One robot's topics: its odometry subscription, command and reference publishers."""
+
+    odometry: Subscription
+    cmd_vel: Publisher
+    reference: Publisher
+
+
+class PlanExecutor(Node):
+    """Serve ``execute_plan``; track the shared plan clock with every robot of the plan."""
+
+    def __init__(self, **kwargs):
+        """Declare the parameters, subscribe to ``plan``, serve the action, start the timer."""
+        super().__init__(EXECUTOR.node_name, **kwargs)
+        self._node_parameters = NodeParameters(self, EXECUTOR)
+        self._plans = PlanStore()
+        self._odometry: dict[str, RobotOdometry] = {}
+        self._links: dict[str, RobotLink] = {}
+        self._run: Run | None = None
+        self.create_subscription(Plan, 'plan', self._on_plan, LATCHED)
+        self._server = ActionServer(self, ExecutePlan, 'execute_plan', self._execute,
+                                    goal_callback=lambda goal: GoalResponse.ACCEPT,
+                                    cancel_callback=self._on_cancel)
+        self._timer = self.create_timer(1.0 / self._settings.control_rate, self._control)
+        self.get_logger().info('serving %s, mode %s, control at %g Hz'
+                               % (self.resolve_service_name('execute_plan'),
+                                  self._settings.mode, self._settings.control_rate))
+
+    @property
+    def _settings(self) -> ExecutorSettings:
+        """Return the accepted parameters: a change applies from the next control step on."""
+        return self._node_parameters.settings
+
+    # ------------------------------------------------------------ inputs
+
+    def _on_plan(self, msg):
+        """Keep a published plan (the last PLAN_HISTORY); subscribe to its robots' odometry."""
+        try:
+            plan = conversions.known_plan(msg)
+        except ValueError as error:
+            self.get_logger().error('plan %d ignored: %s' % (msg.plan_id, error))
+            return
+        self._plans.add(plan)
+        for name in plan.names:
+            self._link(name)
+        self.get_logger().info('plan %d: %d robots, %.3f s, min gap %.6g m, tolerance %.6g m'
+                               % (plan.plan_id, len(plan.names), plan.reference.duration,
+                                  plan.min_gap, plan.tolerance))
+
+    def _link(self, name):
+        """Create the odometry subscription and command publishers of a robot (once)."""
+        if name in self._links:
+            return
+        self._links[name] = RobotLink(
+            self.create_subscription(Odometry, name + '/odom',
+                                     lambda msg, name=name: self._on_odometry(name, msg),
+                                     STATE),
+            self.create_publisher(Twist, name + '/cmd_vel', COMMANDS),
+            self.create_publisher(PoseStamped, name + '/reference_pose', COMMANDS))
+
+    def _on_odometry(self, name, msg):
+        self._odometry[name] = conversions.robot_odometry(msg,
+                                                          self.get_clock().now().nanoseconds)
+
+    # ------------------------------------------------------------ the action
+
+    def _on_cancel(self, goal):
+        """Accept a cancel of the active goal and stop every robot at once."""
+        run = self._run
+        if run is not None and run.goal is goal:
+            self._stop_robots(run.plan.names)
+            self._finish(run, Result.CANCELED, 'canceled at plan time %.3f s'
+                         % (run.execution.plan_time if run.execution else 0.0))
+        return CancelResponse.ACCEPT
+
+    async def _execute(self, goal):
+        """Run one goal to its end; return its ExecutePlan result."""
+        previous = self._run
+        if previous is not None:
+            self._stop_robots(previous.plan.names)
+            self._finish(previous, Result.PREEMPTED, 'preempted by a newer goal')
+        found = self._plans.lookup(goal.request.plan_id, self.resolve_topic_name('plan'))
+        if found.code == Result.NONE:
+            run = Run(goal, found.plan, self.get_clock().now().nanoseconds)
+            self._run = run
+            result = await run.done
+        else:
+            result = Result(error_code=found.code, error_msg=found.message,
+                            plan_id=found.plan.plan_id if found.plan else goal.request.plan_id)
+        if result.error_code == Result.NONE:
+            goal.succeed()
+        elif result.error_code == Result.CANCELED and goal.is_cancel_requested:
+            goal.canceled()
+        else:
+            goal.abort()
+        line = 'goal for plan %d: error %d: %s' % (result.plan_id, result.error_code,
+                                                   result.error_msg)
+        if result.error_code == Result.NONE:
+            self.get_logger().info(line)
+        else:
+            self.get_logger().warning(line)
+        return result
+
+    def _finish(self, run, code, message):
+        """End a run with a result (once); the goal's coroutine resumes with it."""
+        if run.done.done():
+            return
+        if self._run is run:
+            self._run = None
+        execution = run.execution
+        now = self.get_clock().now().nanoseconds
+        result = Result(error_code=code, error_msg=message, plan_id=run.plan.plan_id,
+                        executed_duration=conversions.duration_from_seconds(
+                            (now - run.started_ns) * 1e-9 if run.started_ns else 0.0))
+        if execution is not None:
+            result.max_tracking_errors = execution.max_errors.tolist()
+            result.min_gap = float(execution.min_gap)
+        run.done.set_result(result)
+
+    # ------------------------------------------------------------ the control loop
+
+    def _control(self):
+        """One control step of the active goal (the timer)."""
+        run = self._run
+        if run is None:
+            return
+        try:
+            self._control_run(run)
+        except Exception as error:  # noqa: B902 - a bug ends the goal, not the node
+            self._stop_robots(run.plan.names)
+            self._finish(run, Result.UNKNOWN, 'internal error: %s: %s'
+                         % (type(error).__name__, error))
+
+    def _control_run(self, run):
+        """Start the goal's Execution once every robot reported, then step and publish it."""
+        now = self.get_clock().now().nanoseconds
+        plan, settings = run.plan, self._settings
+        state = fleet_state(plan, self._odometry, now, settings.odom_timeout)
+        if state.wrong_frame:
+            self._stop_robots(plan.names)
+            self._finish(run, Result.FRAME_MISMATCH, state.wrong_frame)
+            return
+        if run.execution is None and not self._start(run, state, now):
+            return
+        step = run.execution.step((now - run.last_ns) * 1e-9, state.positions,
+                                  state.stale_mask)
+        run.last_ns = now
+        self._log_stale(run, state, step.plan_time)
+        self._publish_step(plan, step, state, now)
+        run.goal.publish_feedback(ExecutePlan.Feedback(
+            plan_time=step.plan_time, plan_duration=plan.reference.duration,
+            clock_rate=step.rate, max_tracking_errors=run.execution.max_errors.tolist(),
+            min_gap=float(run.execution.min_gap), stale_robots=list(state.stale)))
+        if step.finished:
+            self._stop_robots(plan.names)
+            self._finish(run, Result.NONE, 'plan %d executed' % plan.plan_id)
+
+    def _start(self, run: Run, state: FleetState, now: int) -> bool:
+        """Start the run's Execution once every robot reported; UNKNOWN_ROBOTS after a wait."""
+        settings, plan = self._settings, run.plan
+        if state.stale:
+            if now - run.requested_ns > settings.discovery_timeout * 1e9:
+                self._finish(run, Result.UNKNOWN_ROBOTS, 'no odometry within %g s from %s '
+                             '(topics %s)' % (settings.discovery_timeout, ', '.join(state.stale),
+                                              ', '.join(self.resolve_topic_name(n + '/odom')
+                                                        for n in state.stale)))
+            return False
+        run.execution = Execution(plan.reference, plan.tolerance, settings.execution,
+                                  plan.bodies)
+        run.started_ns = run.last_ns = now
+        self.get_logger().info('executing plan %d: %d robots, %.3f s'
+                               % (plan.plan_id, len(plan.names), plan.reference.duration))
+        return True
+
+    def _log_stale(self, run: Run, state: FleetState, plan_time: float) -> None:
+        """Say when the plan clock holds for stale odometry, and when it resumes."""
+        if state.stale == run.stale:
+            return
+        if state.stale:
+            self.get_logger().warning('plan clock held at %.3f s: odometry of %s is older '
+                                      'than %g s' % (plan_time, ', '.join(state.stale),
+                                                     self._settings.odom_timeout))
+        else:
+            self.get_logger().info('odometry back; plan clock resumes at %.3f s' % plan_time)
+        run.stale = state.stale
+
+    def _publish_step(self, plan, step, state, now_ns):
+        """Publish every robot's reference pose and, in mode velocity, its body-frame command."""
+        header = conversions.header(plan.frame_id, now_ns)
+        body = Rotation.from_quat(state.orientations).apply(step.velocities, inverse=True)
+        velocity_mode = self._settings.mode == 'velocity'
+        for i, name in enumerate(plan.names):
+            link = self._links[name]
+            link.reference.publish(conversions.pose_stamped(header, step.positions[i],
+                                                            step.orientations[i]))
+            if velocity_mode:
+                link.cmd_vel.publish(conversions.twist(body[i]))
+
+    def _stop_robots(self, names):
+        """Send zero velocity to every named robot (mode velocity)."""
+        if self._settings.mode != 'velocity':
+            return
+        for name in names:
+            self._links[name].cmd_vel.publish(conversions.twist())
+
+    def stop_active_robots(self):
+        """Stop the robots of the active goal (the runtime's before_teardown hook)."""
+        run = self._run
+        if run is not None:
+            self._stop_robots(run.plan.names)
+
+
+def executor_nodes(context=None, **kwargs) -> NodeGroup:
+    """Return the executor, whose robots are stopped before it is destroyed."""
+    node = PlanExecutor(context=context, **kwargs)
+    return NodeGroup([node], before_teardown=node.stop_active_robots)
+
+
+def main(args=None):
+    """Run plan_executor until Ctrl-C or SIGTERM; return 0, or 2 for invalid parameters."""
+    return run_nodes(EXECUTOR.node_name, executor_nodes, args=args)
+
+
+if __name__ == '__main__':
+    sys.exit(main())

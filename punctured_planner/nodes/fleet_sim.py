@@ -1,0 +1,115 @@
+"""
+The fleet_sim node: simulated holonomic disc robots over DDS, for tests, demos and users.
+
+A thin adapter around :class:`punctured_planner.sim.Fleet`: ``<robot>/cmd_vel``
+(geometry_msgs/Twist) in; ``<robot>/odom`` (nav_msgs/Odometry), ``robot_states``
+(geometry_msgs/PoseArray) and ``~/min_gap`` (std_msgs/Float64, the true
+smallest surface gap between bodies so far, latched) out, every step at
+``rate``. Every new contact is logged with the bodies and the gap. Robots
+named in ``muted_robots`` keep moving but publish no odometry (a dropped link),
+settable at run time. Nothing to do before teardown: a simulated robot without
+commands stops by itself.
+"""
+
+import sys
+
+from geometry_msgs.msg import PoseArray
+from geometry_msgs.msg import Twist
+from nav_msgs.msg import Odometry
+import numpy as np
+from rclpy.node import Node
+from std_msgs.msg import Float64
+
+from ..ros import conversions
+from ..ros.parameters import NodeParameters
+from ..ros.qos import COMMANDS
+from ..ros.qos import LATCHED
+from ..ros.runtime import NodeGroup
+from ..ros.runtime import run_nodes
+from ..ros.settings import FLEET_SIM
+from ..ros.settings import FleetSimSettings
+from ..sim import Fleet
+
+
+class FleetSim(Node):
+    """Simulate the fleet at ``rate``: commands in, odometry, states and the true gap out."""
+
+    def __init__(self, **kwargs):
+        """Declare the parameters, build the fleet, subscribe and advertise per robot."""
+        super().__init__(FLEET_SIM.node_name, **kwargs)
+        self._node_parameters = NodeParameters(self, FLEET_SIM, self._apply_parameters)
+        settings = self._node_parameters.settings
+        self._names = settings.robot_names
+        self._fleet = Fleet(settings.initial, settings.fleet())
+        self._period = 1.0 / settings.rate
+        self._start_ns = self.get_clock().now().nanoseconds
+        self._last_ns = self._start_ns
+        self._odometry = []
+        for i, name in enumerate(self._names):
+            self.create_subscription(Twist, name + '/cmd_vel',
+                                     lambda msg, i=i: self._on_command(i, msg), COMMANDS)
+            self._odometry.append(self.create_publisher(Odometry, name + '/odom', COMMANDS))
+        self._states = self.create_publisher(PoseArray, 'robot_states', COMMANDS)
+        self._gap = self.create_publisher(Float64, '~/min_gap', LATCHED)
+        self._timer = self.create_timer(self._period, self._step)
+        self.get_logger().info('%d robots in frame %s at %g Hz; initial gap %.6g m'
+                               % (len(self._names), settings.frame_id, settings.rate,
+                                  self._fleet.min_gap))
+
+    def _seconds(self, now_ns):
+        return (now_ns - self._start_ns) * 1e-9
+
+    def _apply_parameters(self, settings: FleetSimSettings, changed: set[str]) -> None:
+        """Post-set: the fleet's physics (frame and muted robots are read at every step)."""
+        self._fleet.configure(settings.fleet())
+
+    def _on_command(self, robot, msg):
+        velocity = np.array([msg.linear.x, msg.linear.y, msg.linear.z])
+        if not np.all(np.isfinite(velocity)):
+            self.get_logger().warning('%s/cmd_vel: non-finite velocity ignored'
+                                      % self._names[robot])
+            return
+        self._fleet.command(robot, velocity, self._seconds(self.get_clock().now().nanoseconds))
+
+    def _step(self):
+        """One simulation step and its messages (the timer); a bug is logged, not fatal."""
+        try:
+            self._step_and_publish()
+        except Exception as error:  # noqa: B902 - the simulator keeps running
+            self.get_logger().error('step failed: %s: %s' % (type(error).__name__, error))
+
+    def _step_and_publish(self):
+        now_ns = self.get_clock().now().nanoseconds
+        dt = min((now_ns - self._last_ns) * 1e-9, 5 * self._period)
+        self._last_ns = now_ns
+        for contact in self._fleet.step(self._seconds(now_ns) - dt, dt):
+            other = (self._names[contact.second] if contact.kind == 'robots'
+                     else 'obstacle %d' % contact.second)
+            self.get_logger().warning('contact at t = %.3f s: %s and %s, gap %.4f m'
+                                      % (contact.time, self._names[contact.first], other,
+                                         contact.gap))
+        settings = self._node_parameters.settings
+        header = conversions.header(settings.frame_id, now_ns)
+        states = PoseArray(header=header)
+        for i, name in enumerate(self._names):
+            odometry = conversions.odometry(header, name + '/base_link',
+                                            self._fleet.positions[i], self._fleet.velocities[i])
+            states.poses.append(odometry.pose.pose)
+            if name not in settings.muted_robots:
+                self._odometry[i].publish(odometry)
+        self._states.publish(states)
+        self._gap.publish(Float64(data=float(self._fleet.min_gap)))
+
+
+def fleet_sim_nodes(context=None, **kwargs) -> NodeGroup:
+    """Return the simulator's node."""
+    return NodeGroup([FleetSim(context=context, **kwargs)])
+
+
+def main(args=None):
+    """Run fleet_sim until Ctrl-C or SIGTERM; return 0, or 2 for invalid parameters."""
+    return run_nodes(FLEET_SIM.node_name, fleet_sim_nodes, args=args)
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,57 @@
+"""
+nav_msgs/Path messages serialised with numpy, to the byte as rmw_fastrtps writes them.
+
+The planner publishes every robot's Path as these bytes (built once with the
+response's Paths, :func:`punctured_planner.ros.conversions.plan_to_paths`);
+test_conversions compares them with ``rclpy.serialization.serialize_message``.
+"""
+
+import numpy as np
+
+# CDR as rmw_fastrtps writes it: encapsulation header (little endian), then the fields,
+# each aligned to its size counted from the end of the header.
+_CDR_HEADER = b'\x00\x01\x00\x00'
+
+
+def _align(offset, size):
+    return -(-offset // size) * size
+
+
+def _stamped_pose_dtype(frame, start):
+    """Return the numpy layout of a geometry_msgs/PoseStamped in frame ``frame`` at ``start``."""
+    pose = _align(start + 13 + len(frame), 8) - start  # stamp, string (length, bytes, NUL)
+    return np.dtype({'names': ['sec', 'nanosec', 'length', 'frame', 'pose'],
+                     'formats': ['<i4', '<u4', '<u4', 'S%d' % (len(frame) + 1), ('<f8', 7)],
+                     'offsets': [0, 4, 8, 12, pose], 'itemsize': pose + 56})
+
+
+def serialized_paths(frame_id, start_ns, stamps, values):
+    """
+    Return nav_msgs/Paths serialised, built with numpy: one per row of values (k, M, 7).
+
+    The bytes ``rclpy.serialization.serialize_message`` gives for the Paths of
+    :func:`~punctured_planner.ros.conversions.plan_to_paths` (padding zeroed): header
+    stamp start_ns, poses stamped ``stamps`` (M,) ns in frame_id, with positions and
+    orientations ``values``.
+    """
+    frame = frame_id.encode()
+    robots, count = values.shape[:2]
+    first = _align(13 + len(frame), 4) + 4  # header, then the sequence length
+    head = _stamped_pose_dtype(frame, first)
+    rest = _stamped_pose_dtype(frame, 0)  # a pose ends 8-aligned: the rest repeat
+    size = first + (head.itemsize + (count - 1) * rest.itemsize if count else 0)
+    body = np.zeros((robots, size), dtype=np.uint8)
+    stamp_sec, stamp_nanosec = divmod(int(start_ns), 1000000000)
+    body[:, :12].view('<u4')[:] = (stamp_sec, stamp_nanosec, len(frame) + 1)
+    body[:, 12:12 + len(frame)] = np.frombuffer(frame, dtype=np.uint8)
+    body[:, first - 4:first].view('<u4')[:] = count
+    for dtype, start, select in ((head, first, slice(0, 1)),
+                                 (rest, first + head.itemsize, slice(1, None))):
+        elements = np.zeros((robots, len(stamps[select])), dtype=dtype)
+        elements['sec'], elements['nanosec'] = divmod(stamps[select], 1000000000)
+        elements['length'] = len(frame) + 1
+        elements['frame'] = frame
+        elements['pose'] = values[:, select]
+        body[:, start:start + elements.shape[1] * dtype.itemsize] = elements.view(
+            np.uint8).reshape(robots, -1)
+    return [_CDR_HEADER + row.tobytes() for row in body]

@@ -1,0 +1,335 @@
+"""
+The ROS-level checks of a PlanSequence request, in the priority order of the error codes.
+
+1. NO_CONFIGURATIONS, 2. NO_ROBOT_STATE, 3. REQUEST_OVER_LIMITS (from list
+lengths, before any conversion or allocation), 4. INVALID_REQUEST,
+5. ROBOT_COUNT_MISMATCH, 6. NON_FINITE_VALUE, 7. FRAME_MISMATCH, 8. OFF_PLANE;
+the core's own checks come after (9-12). The finiteness check runs here,
+before the frame and plane checks, because its code comes first and in
+planar mode the core never sees z. Each raises a PlanningError with its
+culprits as data; :mod:`punctured_planner.ros.wording` names them.
+"""
+
+from dataclasses import dataclass
+import math
+from typing import Any
+
+import numpy as np
+
+from . import conversions
+from .settings import MAX_SAMPLES_PER_LEG
+from .settings import PlannerSettings
+from .snapshot import format_stamp
+from .snapshot import ObstacleSet
+from .snapshot import RobotState
+from .snapshot import Snapshot
+from ..core import ErrorCode
+from ..core import first_out_of_range
+from ..core import MAX_COORDINATE
+from ..core import PlanningError
+from ..core import SCHEDULES
+from ..core.errors import literal
+
+# Largest |z - plane_z| accepted in planar mode (m).
+PLANE_TOLERANCE = 1e-9
+# builtin_interfaces/Time holds int32 seconds: no stamp may reach 2^31 s.
+_LAST_STAMP_NS = (2 ** 31 - 1) * 1000000000
+_AXES = 'xyz'
+
+
+@dataclass(frozen=True, eq=False)
+class Gathered:
+    """A request's inputs from list lengths and options alone (step 1, nothing converted)."""
+
+    configurations: list
+    state: RobotState | None
+    counts: list[int]
+    max_speed: float
+    samples_per_leg: int
+
+    def label(self, m: int) -> str:
+        """
+        Return how every message names configuration m (0-based, the state first).
+
+        With use_current_state, configuration 0 is the state (named with its
+        source) and configuration m is the request's configurations[m - 1].
+        """
+        if self.state is None:
+            return 'configuration %d' % m
+        if m == 0:
+            return 'configuration 0 (the current robot state from %s)' % self.state.source
+        return 'configuration %d (request configurations[%d])' % (m, m - 1)
+
+
+@dataclass(frozen=True, eq=False)
+class Checked:
+    """
+    The converted, checked inputs (step 2).
+
+    positions (n, k, 3) and orientations (n, k, 4) of the configurations that
+    are planned; ``planned[i]`` is the configuration number (as labelled) of
+    the i-th of them, and ``dropped`` the request indices left out because
+    they repeat the current state (doc/design.md section 12).
+    """
+
+    positions: np.ndarray
+    orientations: np.ndarray
+    planned: list[int]
+    dropped: list[int]
+
+
+def fail(code: ErrorCode, message: str, **culprits: Any) -> None:
+    """Raise a PlanningError whose message is free text (no slots) and the culprits."""
+    raise PlanningError(code, literal(message), **culprits)
+
+
+def gather(request: Any, snapshot: Snapshot, now_ns: int) -> Gathered:
+    """Step 1: the inputs from list lengths and options; codes 1-4 that need no values."""
+    settings = snapshot.settings
+    configurations = list(request.configurations)
+    use_state = bool(request.use_current_state)
+    state = snapshot.state if use_state else None
+    n = len(configurations) + (1 if use_state else 0)
+    if n < 2:
+        fail(ErrorCode.NO_CONFIGURATIONS,
+             'need at least 2 configurations in total, got %d (%d in the request%s)'
+             % (n, len(configurations), ' + the current state' if use_state else ''))
+    if use_state and state is None:
+        fail(ErrorCode.NO_ROBOT_STATE, 'use_current_state is set but ' + snapshot.state_problem)
+    if state is not None:
+        _check_state_age(settings, state, now_ns)
+    counts = ([len(state.positions)] if state is not None else []) + [
+        len(c.poses) for c in configurations]
+    samples = (request.samples_per_leg if request.samples_per_leg >= 0
+               else settings.samples_per_leg)
+    _check_limits(settings, n, counts, samples)
+    max_speed = request.max_speed
+    if not math.isfinite(max_speed):
+        fail(ErrorCode.INVALID_REQUEST, 'max_speed must be finite, got %r' % max_speed)
+    for m, count in enumerate(counts):
+        if count == 0:
+            raise PlanningError(ErrorCode.INVALID_REQUEST, '{configuration} has no robots',
+                                configuration=m)
+    return Gathered(configurations, state, counts,
+                    max_speed if max_speed > 0 else settings.max_speed, samples)
+
+
+def _check_state_age(settings: PlannerSettings, state: RobotState, now_ns: int) -> None:
+    """NO_ROBOT_STATE when the state is older than max_state_age (0: no limit)."""
+    age = (int(now_ns) - state.received_ns) * 1e-9
+    if settings.max_state_age > 0 and age > settings.max_state_age:
+        fail(ErrorCode.NO_ROBOT_STATE, 'use_current_state is set but the robot state from %s '
+             'is %.3f s old (received at %s, stamp %s), more than max_state_age %g s'
+             % (state.source, age, format_stamp(state.received_ns),
+                format_stamp(state.stamp_ns), settings.max_state_age))
+
+
+def _check_limits(settings: PlannerSettings, n: int, counts: list[int], samples: int) -> None:
+    """REQUEST_OVER_LIMITS from lengths alone, before anything is converted."""
+    if n > settings.max_configurations:
+        fail(ErrorCode.REQUEST_OVER_LIMITS, '%d configurations, more than '
+             'max_configurations %d' % (n, settings.max_configurations))
+    k = max(counts)
+    if k > settings.max_robots:
+        m = counts.index(k)
+        raise PlanningError(ErrorCode.REQUEST_OVER_LIMITS, '{configuration} has %d robots, '
+                            'more than max_robots %d' % (k, settings.max_robots),
+                            configuration=m)
+    if samples > MAX_SAMPLES_PER_LEG:
+        fail(ErrorCode.REQUEST_OVER_LIMITS, 'samples_per_leg %d is more than %d'
+             % (samples, MAX_SAMPLES_PER_LEG))
+    schedule = SCHEDULES.get(settings.core_variant)
+    if schedule is not None:  # 'discs' has no fixed legs: checked once planned
+        check_poses(settings, k, schedule.breakpoint_count(n), samples)
+
+
+def check_poses(settings: PlannerSettings, robot_count: int, breakpoints: int,
+                samples: int) -> None:
+    """REQUEST_OVER_LIMITS when robot_count paths through breakpoints would pass max_poses."""
+    poses = robot_count * ((breakpoints - 1) * (samples + 1) + 1)
+    if poses > settings.max_poses:
+        fail(ErrorCode.REQUEST_OVER_LIMITS, 'the answer would hold %d poses (%d robots x '
+             '%d poses), more than max_poses %d' % (poses, robot_count,
+                                                    poses // max(robot_count, 1),
+                                                    settings.max_poses))
+
+
+def check_duration(duration: float, max_speed: float, start_ns: int) -> None:
+    """
+    INVALID_REQUEST when the motion's stamps do not fit builtin_interfaces/Time.
+
+    Time and Duration carry int32 seconds: the last stamp must come before
+    2038-01-19 and the duration must stay below 2^31 s. Known only once the
+    plan's length is, so checked after planning.
+    """
+    if not (math.isfinite(duration) and start_ns + duration * 1e9 < _LAST_STAMP_NS):
+        fail(ErrorCode.INVALID_REQUEST, 'the motion would last %.6g s at max_speed %.6g '
+             'm/s: its stamps would pass the largest builtin_interfaces/Time '
+             '(2038-01-19T03:14:07Z); raise max_speed' % (duration, max_speed))
+
+
+def check(gathered: Gathered, snapshot: Snapshot) -> Checked:
+    """Step 2: convert the poses; the range, count, finiteness, frame and plane checks."""
+    settings, obstacles, state = snapshot.settings, snapshot.obstacles, gathered.state
+    states = [state] if state is not None else []
+    arrays = [s.positions for s in states] + [
+        conversions.pose_array_positions(c) for c in gathered.configurations]
+    _check_range(settings, arrays)
+    check_obstacle_range(settings, obstacles)
+    _check_counts(settings, gathered)
+    positions = np.stack(arrays)
+    orientations = np.stack([s.orientations for s in states] + [
+        conversions.pose_array_orientations(c) for c in gathered.configurations])
+    frames = [s.frame_id for s in states] + [c.header.frame_id for c in gathered.configurations]
+    _check_non_finite(positions)
+    check_obstacle_values(obstacles)
+    _check_frames(settings, frames)
+    check_obstacle_frame(settings, obstacles)
+    _check_plane(settings, positions)
+    check_obstacle_plane(settings, obstacles)
+    planned = list(range(len(positions)))
+    if state is not None:
+        planned = _without_repeats(settings, positions, state)
+    dropped = [m - 1 for m in range(1, len(positions)) if m not in planned]
+    return Checked(positions[planned], orientations[planned], planned, dropped)
+
+
+def _check_range(settings: PlannerSettings, arrays: list[np.ndarray]) -> None:
+    """
+    INVALID_REQUEST for a finite coordinate beyond the core's range (+-1e15).
+
+    The core checks this too, but only after codes 5-8; here it keeps the
+    documented priority. Only the d coordinates the core plans in count (in
+    planar mode z has its own check, OFF_PLANE); non-finite values are
+    NON_FINITE_VALUE.
+    """
+    for m, points in enumerate(arrays):
+        far = first_out_of_range(points[:, :settings.dimension])
+        if far is not None:
+            robot, axis = far
+            raise PlanningError(
+                ErrorCode.INVALID_REQUEST, '{configuration}, robot %d: %s = %.6g is beyond '
+                'the supported range +-%.0e' % (robot, _AXES[axis], float(points[far]),
+                                                MAX_COORDINATE),
+                configuration=m, robots=[robot], coordinate=axis)
+
+
+def check_obstacle_range(settings: PlannerSettings, obstacles: ObstacleSet) -> None:
+    """INVALID_REQUEST for an obstacle coordinate beyond the core's range."""
+    far = first_out_of_range(obstacles.points[:, :settings.dimension])
+    if far is not None:
+        j, axis = far
+        raise PlanningError(ErrorCode.INVALID_REQUEST, '{obstacle}: %s = %.6g is beyond the '
+                            'supported range +-%.0e' % (_AXES[axis], float(obstacles.points[far]),
+                                                        MAX_COORDINATE),
+                            obstacle=j, coordinate=axis)
+
+
+def _check_counts(settings: PlannerSettings, gathered: Gathered) -> None:
+    """
+    ROBOT_COUNT_MISMATCH, blaming the configuration that differs from the reference.
+
+    The reference is the node's robot_count (or robot_names) when set, else
+    configuration 0: so a state message with the wrong count is the one named.
+    """
+    counts = gathered.counts
+    expected = settings.expected_robot_count
+    if expected:
+        what = ('the %d robot_names' % expected if settings.robot_names
+                else 'robot_count %d' % expected)
+        for m, count in enumerate(counts):
+            if count != expected:
+                raise PlanningError(ErrorCode.ROBOT_COUNT_MISMATCH, '{configuration} has %d '
+                                    'robots but the node is configured for %s' % (count, what),
+                                    configuration=m)
+    for m, count in enumerate(counts):
+        if count != counts[0]:
+            raise PlanningError(ErrorCode.ROBOT_COUNT_MISMATCH, '{configuration} has %d '
+                                'robots, %s has %d' % (count, literal(gathered.label(0)),
+                                                       counts[0]), configuration=m)
+
+
+def _check_non_finite(positions: np.ndarray) -> None:
+    """NON_FINITE_VALUE in the robots' coordinates."""
+    bad = conversions.first_non_finite(positions)
+    if bad is not None:
+        m, robot, axis = bad
+        raise PlanningError(ErrorCode.NON_FINITE_VALUE, '{configuration}, robot %d: %s is %r'
+                            % (robot, _AXES[axis], float(positions[bad])),
+                            configuration=m, robots=[robot], coordinate=axis)
+
+
+def check_obstacle_values(obstacles: ObstacleSet) -> None:
+    """NON_FINITE_VALUE in the obstacles' coordinates."""
+    bad = conversions.first_non_finite(obstacles.points)
+    if bad is not None:
+        raise PlanningError(ErrorCode.NON_FINITE_VALUE, '{obstacle}: %s is %r'
+                            % (_AXES[bad[1]], float(obstacles.points[bad])),
+                            obstacle=bad[0], coordinate=bad[1])
+
+
+def _check_frames(settings: PlannerSettings, frames: list[str]) -> None:
+    """FRAME_MISMATCH: a configuration in a frame other than the planning frame."""
+    for m, frame_id in enumerate(frames):
+        if frame_id and frame_id != settings.frame_id:
+            raise PlanningError(ErrorCode.FRAME_MISMATCH, "{configuration} is in frame '%s', "
+                                "the planning frame is '%s'" % (literal(frame_id),
+                                                                literal(settings.frame_id)),
+                                configuration=m)
+
+
+def check_obstacle_frame(settings: PlannerSettings, obstacles: ObstacleSet) -> None:
+    """FRAME_MISMATCH: obstacles in a frame other than the planning frame."""
+    if obstacles.frame_id and obstacles.frame_id != settings.frame_id:
+        fail(ErrorCode.FRAME_MISMATCH, "the obstacles (from %s) are in frame '%s', the "
+             "planning frame is '%s'" % (obstacles.origin, obstacles.frame_id,
+                                         settings.frame_id))
+
+
+def _check_plane(settings: PlannerSettings, positions: np.ndarray) -> None:
+    """OFF_PLANE in planar mode: a robot off the plane z = plane_z."""
+    if settings.dimension != 2:
+        return
+    off = np.abs(positions[..., 2] - settings.plane_z) > PLANE_TOLERANCE
+    if off.any():
+        m, robot = (int(i) for i in np.argwhere(off)[0])
+        raise PlanningError(ErrorCode.OFF_PLANE, '{configuration}, robot %d: z = %r but '
+                            'plane_z is %r (dimension 2)' % (robot, float(positions[m, robot, 2]),
+                                                             settings.plane_z),
+                            configuration=m, robots=[robot], coordinate=2)
+
+
+def check_obstacle_plane(settings: PlannerSettings, obstacles: ObstacleSet) -> None:
+    """OFF_PLANE in planar mode: an obstacle off the plane z = plane_z."""
+    if settings.dimension != 2:
+        return
+    off = np.abs(obstacles.points[:, 2] - settings.plane_z) > PLANE_TOLERANCE
+    if off.any():
+        j = int(np.argmax(off))
+        raise PlanningError(ErrorCode.OFF_PLANE, '{obstacle}: z = %r but plane_z is %r '
+                            '(dimension 2)' % (float(obstacles.points[j, 2]), settings.plane_z),
+                            obstacle=j, coordinate=2)
+
+
+def _without_repeats(settings: PlannerSettings, positions: np.ndarray,
+                     state: RobotState) -> list[int]:
+    """
+    Return the configuration numbers to plan: the state, then the request without repeats.
+
+    Leading request configurations that repeat the current state are left out
+    (doc/design.md section 12).
+
+    A request configuration repeats the state when every robot is within
+    repeat_tolerance of its current position (in the planned coordinates).
+    Raise NO_CONFIGURATIONS when the whole request repeats the state.
+    """
+    d = settings.dimension
+    planar = positions[..., :d]
+    distances = np.linalg.norm(planar[1:] - planar[0], axis=2).max(axis=1)
+    repeats = distances <= settings.repeat_tolerance
+    first = int(np.argmin(repeats)) if not repeats.all() else len(repeats)
+    if first == len(repeats):
+        fail(ErrorCode.NO_CONFIGURATIONS, 'every request configuration repeats the current '
+             'robot state from %s within repeat_tolerance %g m: the robots are already '
+             'there, nothing to plan' % (state.source, settings.repeat_tolerance))
+    return [0] + list(range(first + 1, len(positions)))

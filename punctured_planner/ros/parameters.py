@@ -1,0 +1,327 @@
+"""
+The parameter machinery of every node: a Spec per parameter, a Table per node.
+
+A :class:`Spec` carries everything about one parameter: kind, default,
+range or choices, its own check and its description; the specs several nodes
+share (frame, obstacles, radii) are defined once, below. A node's settings
+are a frozen dataclass whose fields are made by :meth:`Spec.field`, so the
+defaults are written once; :class:`Table` reads the specs back from the
+dataclass, in field order, and builds validated settings from parameter
+values (the cross-parameter checks too). :class:`NodeParameters` binds a
+table to a node the one way: declare every spec with its descriptor,
+validate a change in the on-set callback (a refused change keeps the old
+value, with the reason), apply it in the post-set callback.
+The tables themselves are in :mod:`punctured_planner.ros.settings`.
+"""
+
+import dataclasses
+from dataclasses import dataclass
+import math
+import re
+from typing import Any
+from typing import Callable
+from typing import Generic
+from typing import Iterable
+from typing import TypeVar
+
+from rcl_interfaces.msg import FloatingPointRange
+from rcl_interfaces.msg import IntegerRange
+from rcl_interfaces.msg import ParameterDescriptor
+from rcl_interfaces.msg import ParameterType
+from rcl_interfaces.msg import SetParametersResult
+import yaml
+
+_KINDS = {
+    'string': ParameterType.PARAMETER_STRING,
+    'integer': ParameterType.PARAMETER_INTEGER,
+    'double': ParameterType.PARAMETER_DOUBLE,
+    'string_array': ParameterType.PARAMETER_STRING_ARRAY,
+    'double_array': ParameterType.PARAMETER_DOUBLE_ARRAY,
+}
+# Names usable as the first token of '<name>/plan', '<name>/odom' and '<name>/cmd_vel'.
+_NAME = re.compile(r'^[A-Za-z_][A-Za-z0-9_]*(/[A-Za-z_][A-Za-z0-9_]*)*$')
+
+
+@dataclass(frozen=True)
+class Spec:
+    """
+    One parameter: name, kind, default, range (inclusive) or choices, check, description.
+
+    ``check(name, value)`` raises ValueError with the reason for a value of
+    the right kind that is still refused; ``prose`` says in words what the
+    check accepts (the descriptor's additional_constraints).
+    """
+
+    name: str
+    kind: str  # 'string', 'integer', 'double', 'string_array', 'double_array'
+    default: object
+    description: str
+    low: Any = None
+    high: Any = None
+    choices: tuple = ()
+    check: Callable[[str, Any], None] | None = None
+    prose: str = ''
+    read_only: bool = False
+
+    @property
+    def constraints(self) -> str:
+        """Return the accepted values in words, for a value without a range."""
+        if self.choices:
+            quoted = ["'%s'" % choice for choice in self.choices]
+            return ', '.join(quoted[:-1]) + ' or ' + quoted[-1]
+        return self.prose
+
+    def field(self) -> Any:
+        """Return the dataclass field of this parameter: its default (frozen), the spec."""
+        default = tuple(self.default) if isinstance(self.default, list) else self.default
+        return dataclasses.field(default=default, metadata={'spec': self})
+
+    def value(self, raw: object) -> Any:
+        """Return raw converted to the parameter's kind and checked; raise ValueError (reason)."""
+        value = _coerce(self, raw)
+        if self.low is not None and not self.low <= value <= self.high:
+            raise ValueError('%s must be in [%s, %s], got %r'
+                             % (self.name, self.low, self.high, value))
+        if self.choices and value not in self.choices:
+            raise ValueError('%s must be one of %s, got %r'
+                             % (self.name, ', '.join(self.choices), value))
+        if self.check is not None:
+            self.check(self.name, value)
+        return value
+
+    def descriptor(self) -> ParameterDescriptor:
+        """Return the rcl_interfaces ParameterDescriptor of the parameter."""
+        result = ParameterDescriptor(name=self.name, type=_KINDS[self.kind],
+                                     description=self.description,
+                                     additional_constraints=self.constraints,
+                                     read_only=self.read_only)
+        # Doubles accept YAML integers (plane_z: 0) and arrays accept [] (an untyped
+        # empty list): their type is checked by Spec.value instead.
+        result.dynamic_typing = self.kind in ('double', 'string_array', 'double_array')
+        if self.kind == 'integer' and self.low is not None:
+            result.integer_range = [IntegerRange(from_value=self.low, to_value=self.high,
+                                                 step=1)]
+        if self.kind == 'double' and self.low is not None:
+            result.floating_point_range = [FloatingPointRange(
+                from_value=float(self.low), to_value=float(self.high), step=0.0)]
+        return result
+
+
+def _is_number(value: object) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _coerce(spec: Spec, value: object) -> Any:
+    """Return value converted to the parameter's kind, or raise ValueError with a reason."""
+    if spec.kind == 'string':
+        if not isinstance(value, str):
+            raise ValueError('%s must be a string, got %r' % (spec.name, value))
+        return value
+    if spec.kind == 'integer':
+        if not isinstance(value, int) or isinstance(value, bool):
+            raise ValueError('%s must be an integer, got %r' % (spec.name, value))
+        return int(value)
+    if spec.kind == 'double':
+        if not _is_number(value):
+            raise ValueError('%s must be a number, got %r' % (spec.name, value))
+        number = float(value)  # type: ignore[arg-type]  # a number, checked above
+        if not math.isfinite(number):
+            raise ValueError('%s must be finite, got %r' % (spec.name, number))
+        return number
+    if value is None:
+        return ()
+    if isinstance(value, (str, bytes)) or not isinstance(value, Iterable):
+        raise ValueError('%s must be a list, got %r' % (spec.name, value))
+    items = list(value)
+    if spec.kind == 'string_array':
+        if not all(isinstance(item, str) for item in items):
+            raise ValueError('%s must be a list of strings, got %r' % (spec.name, items))
+        return tuple(items)
+    if not all(_is_number(item) for item in items):
+        raise ValueError('%s must be a list of numbers, got %r' % (spec.name, items))
+    numbers = tuple(float(item) for item in items)
+    bad = [i for i, item in enumerate(numbers) if not math.isfinite(item)]
+    if bad:
+        raise ValueError('%s[%d] is %r: values must be finite'
+                         % (spec.name, bad[0], numbers[bad[0]]))
+    return numbers
+
+
+# ---------------------------------------------------------------- checks of one value
+
+def non_empty(name: str, value: str) -> None:
+    """Refuse an empty string."""
+    if not value:
+        raise ValueError('%s must not be empty' % name)
+
+
+def triples(name: str, value: tuple) -> None:
+    """Refuse a flat list that is not x, y, z per point."""
+    if len(value) % 3:
+        raise ValueError('%s must hold x, y, z per obstacle: %d values is not a multiple of 3'
+                         % (name, len(value)))
+
+
+def non_negative(name: str, value: tuple) -> None:
+    """Refuse a list with a negative value."""
+    if any(item < 0 for item in value):
+        raise ValueError('%s values must be >= 0, got %r' % (name, list(value)))
+
+
+def ros_names(name: str, value: tuple) -> None:
+    """Refuse names that are not unique relative ROS names."""
+    for item in value:
+        if not _NAME.match(item):
+            raise ValueError('%s: %r is not a valid relative ROS name' % (name, item))
+    if len(set(value)) != len(value):
+        raise ValueError('%s must be unique, got %r' % (name, list(value)))
+
+
+def within(low: float, high: float) -> Callable[[str, tuple], None]:
+    """Return the check that every value of a list is in [low, high]."""
+    def check(name: str, value: tuple) -> None:
+        bad = [i for i, item in enumerate(value) if not low <= item <= high]
+        if bad:
+            raise ValueError('%s[%d] = %r is outside [%g, %g]'
+                             % (name, bad[0], value[bad[0]], low, high))
+    return check
+
+
+# ---------------------------------------------------------------- shared specs
+
+FRAME_ID = Spec(
+    'frame_id', 'string', 'map',
+    'The planning frame: frame_id of every message the node publishes; inputs with a '
+    'non-empty header.frame_id must name it.', check=non_empty, prose='non-empty')
+OBSTACLES = Spec(
+    'obstacles', 'double_array', [],
+    'Obstacle centres as a flat list x0, y0, z0, x1, y1, z1, ...; for planner_node the '
+    "latest of this parameter and the 'obstacles' topic is the obstacle set.",
+    check=triples, prose='length a multiple of 3, finite values')
+ROBOT_RADIUS = Spec(
+    'robot_radius', 'double', 0.0,
+    'Radius R of every robot (m): robots are discs (balls for dimension 3) and the gap of '
+    'two robots is their centre distance - 2R; planner_node refuses overlapping bodies, '
+    'and its min_gap and required_clearance are surface gaps.', low=0.0, high=1e6)
+OBSTACLE_RADIUS = Spec(
+    'obstacle_radius', 'double_array', [],
+    'Radius rho of the obstacles (m): empty for 0, one value for all, or one per obstacle '
+    'in obstacle order; a robot-obstacle gap is centre distance - R - rho.',
+    check=non_negative, prose='empty, one value or one per obstacle; finite, >= 0')
+
+
+# ---------------------------------------------------------------- tables
+
+S = TypeVar('S')
+
+
+class Table(Generic[S]):
+    """
+    A node's parameters: the specs of a settings dataclass, and the settings from values.
+
+    ``checks`` are the cross-parameter rules: each takes the settings and
+    raises ValueError with the reason.
+    """
+
+    def __init__(self, node_name: str, settings_type: type[S],
+                 checks: tuple[Callable[[S], None], ...] = ()) -> None:
+        """Read the specs from the fields of settings_type (made by Spec.field)."""
+        self.node_name = node_name
+        self.settings_type = settings_type
+        self.specs: tuple[Spec, ...] = tuple(
+            item.metadata['spec'] for item in dataclasses.fields(settings_type))  # type: ignore
+        for item, spec in zip(dataclasses.fields(settings_type), self.specs):  # type: ignore
+            assert item.name == spec.name, (item.name, spec.name)
+        self.by_name = {spec.name: spec for spec in self.specs}
+        self._checks = checks
+
+    def settings(self, values: dict) -> S:
+        """
+        Return the settings of parameter values (missing names keep their defaults).
+
+        Raises ValueError whose message is the reason a value is refused; unknown
+        names are refused too.
+        """
+        merged = {}
+        for name, value in values.items():
+            if name not in self.by_name:
+                raise ValueError('unknown parameter %r (parameters: %s)'
+                                 % (name, ', '.join(self.by_name)))
+            merged[name] = self.by_name[name].value(value)
+        settings = self.settings_type(**merged)
+        for check in self._checks:
+            check(settings)
+        return settings
+
+
+class NodeParameters(Generic[S]):
+    """
+    A table bound to a node: declared, validated in on-set, applied in post-set.
+
+    :attr:`settings` is always the node's accepted settings; ``apply(settings,
+    changed names)``, when given, takes them further into the node;
+    it runs in the post-set callback, so a change it cannot take is logged,
+    never raised into the parameter service.
+    """
+
+    def __init__(self, node: Any, table: Table[S],
+                 apply: Callable[[S, set[str]], None] | None = None) -> None:
+        """Declare every parameter; raise ValueError for invalid start values."""
+        self._node = node
+        self._table = table
+        self._apply = apply
+        for spec in table.specs:
+            node.declare_parameter(spec.name, spec.default, spec.descriptor())
+        self.settings: S = table.settings(self.values())
+        node.add_on_set_parameters_callback(self._on_set)
+        node.add_post_set_parameters_callback(self._after_set)
+
+    def values(self, change: Iterable[Any] = ()) -> dict:
+        """Return the node's parameter values, with a proposed change (rclpy Parameters)."""
+        values = {name: self._node.get_parameter(name).value for name in self._table.by_name}
+        values.update({p.name: p.value for p in change if p.name in self._table.by_name})
+        return values
+
+    def _on_set(self, parameters: list) -> SetParametersResult:
+        """Refuse a change that makes the settings invalid, with the reason."""
+        try:
+            self._table.settings(self.values(parameters))
+        except ValueError as error:
+            return SetParametersResult(successful=False, reason=str(error))
+        return SetParametersResult(successful=True)
+
+    def _after_set(self, parameters: list) -> None:
+        """Take the accepted values into the settings and the node."""
+        try:
+            self.settings = self._table.settings(self.values())
+            if self._apply is not None:
+                self._apply(self.settings, {p.name for p in parameters})
+        except Exception as error:  # a parameter change never stops the node
+            self._node.get_logger().error('applying parameters failed: %r' % error)
+            return
+        self._node.get_logger().info('parameters set: %s' % ', '.join(
+            '%s=%r' % (p.name, p.value) for p in parameters))
+
+
+def load_parameter_file(path: str, node_name: str) -> dict:
+    """
+    Return one node's parameter values from a ROS 2 parameter YAML file.
+
+    Sections that apply to the node are merged in file order: ``/**``, the node's
+    name with or without a leading slash or namespace. Raises ValueError for a
+    file that is not a ROS parameter file.
+    """
+    with open(path, encoding='utf-8') as stream:
+        data = yaml.safe_load(stream) or {}
+    if not isinstance(data, dict):
+        raise ValueError('%s: not a ROS parameter file (a mapping of node names)' % path)
+    values: dict = {}
+    for key, section in data.items():
+        key = str(key)
+        applies = key in ('/**', '**') or key.rstrip('/').split('/')[-1] == node_name
+        if not applies:
+            continue
+        if not isinstance(section, dict) or 'ros__parameters' not in section:
+            raise ValueError('%s: section %r has no ros__parameters' % (path, key))
+        values.update(section['ros__parameters'] or {})
+    return values

@@ -1,0 +1,146 @@
+"""
+One PlanSequence request against one snapshot: the ROS-level checks, then the core.
+
+This is the service's logic without the ROS graph: the node calls it with a
+snapshot of its subscriptions and parameters, ``punctured-planner plan`` calls
+it offline with a parameter file. :meth:`PlanSequenceHandler.handle` runs
+named steps that return values, as nav2's computePlan: gather and check
+(:mod:`punctured_planner.ros.checks`, codes 1-8 in priority order), plan (the
+core: codes 9-12) and answer (paths and response). Every PlanningError they
+raise is worded (:mod:`punctured_planner.ros.wording`) and becomes the
+response's error code in one place, :meth:`PlanSequenceHandler.handle`.
+"""
+
+from collections import OrderedDict
+import threading
+import time
+from typing import Any
+
+import numpy as np
+
+from . import checks
+from . import conversions
+from .settings import PlannerSettings
+from .snapshot import ObstacleSet
+from .snapshot import Outcome
+from .snapshot import Snapshot
+from .wording import ObstacleNames
+from .wording import RequestNames
+from .. import core
+from ..core import ErrorCode
+from ..core import PlanningError
+from ..core import SCHEDULES
+from ..core import Workspace
+
+
+class PlanSequenceHandler:
+    """Answers PlanSequence requests; keeps the last few Workspaces (one per obstacle set)."""
+
+    def __init__(self, cache_size: int = 4) -> None:
+        """Create an empty workspace cache."""
+        self._cache: OrderedDict = OrderedDict()
+        self._cache_size = cache_size
+        self._lock = threading.Lock()
+
+    def workspace(self, settings: PlannerSettings, obstacles: np.ndarray) -> Workspace:
+        """
+        Return the Workspace for planar/3-D obstacles (r, d) and the settings (cached).
+
+        The frame is fixed per obstacle set and options, so equal obstacle sets
+        give the same Workspace object (and the same domains). Raises PlanningError.
+        """
+        obstacles = np.ascontiguousarray(obstacles, dtype=float)
+        key = (obstacles.shape, obstacles.tobytes(), settings.dimension, settings.core_variant,
+               settings.lane_spacing, settings.min_spacing, settings.required_clearance,
+               settings.robot_radius, settings.obstacle_radius)
+        with self._lock:
+            found = self._cache.get(key)
+            if found is not None:
+                self._cache.move_to_end(key)
+                return found
+        workspace = Workspace(obstacles, dimension=settings.dimension,
+                              lane_spacing=settings.lane_spacing,
+                              variant=settings.core_variant, min_spacing=settings.min_spacing,
+                              required_clearance=settings.required_clearance,
+                              robot_radius=settings.robot_radius,
+                              obstacle_radius=settings.core_obstacle_radius)
+        with self._lock:
+            self._cache[key] = workspace
+            while len(self._cache) > self._cache_size:
+                self._cache.popitem(last=False)
+        return workspace
+
+    def handle(self, request: Any, response: Any, snapshot: Snapshot,
+               now_ns: int) -> Outcome:
+        """
+        Answer ``request`` against ``snapshot``; return an Outcome (never raises).
+
+        now_ns is the request time; the paths start at now_ns + planning time.
+        Unexpected exceptions become error_code UNKNOWN with their message (and
+        are kept in Outcome.exception for the log).
+        """
+        started = time.perf_counter()
+        gathered = checked = None
+        try:
+            gathered = checks.gather(request, snapshot, now_ns)
+            checked = checks.check(gathered, snapshot)
+            the_plan = self._plan(checked, snapshot)
+            return self._answer(response, gathered, checked, the_plan, snapshot.settings,
+                                now_ns, started)
+        except PlanningError as error:
+            names = (RequestNames(snapshot.obstacles, gathered.label,
+                                  checked.planned if checked is not None else None)
+                     if gathered is not None else ObstacleNames(snapshot.obstacles))
+            conversions.fill_error(response, error.code, error.describe(names),
+                                   time.perf_counter() - started, error.clearance, error.gap)
+            return Outcome(response=response)
+        except Exception as error:  # any bug becomes UNKNOWN, the node serves on
+            conversions.fill_error(response, ErrorCode.UNKNOWN,
+                                   'internal error: %s: %s' % (type(error).__name__, error),
+                                   time.perf_counter() - started)
+            return Outcome(response=response, exception=error)
+
+    def check_obstacles(self, settings: PlannerSettings, obstacles: ObstacleSet) -> None:
+        """
+        Raise PlanningError if an obstacle set cannot be planned in.
+
+        The node calls this when a set arrives, so a bad set is refused at once
+        and the previous good set stays; requests run the same checks again.
+        The node words the error with :class:`ObstacleNames`.
+        """
+        checks.check_obstacle_values(obstacles)
+        checks.check_obstacle_frame(settings, obstacles)
+        checks.check_obstacle_plane(settings, obstacles)
+        checks.check_obstacle_range(settings, obstacles)
+        self.workspace(settings, conversions.leading_coordinates(obstacles.points,
+                                                                 settings.dimension))
+
+    def _plan(self, checked: checks.Checked, snapshot: Snapshot) -> core.Plan:
+        """Step 3: the core's certified plan of the planned coordinates."""
+        d = snapshot.settings.dimension
+        workspace = self.workspace(snapshot.settings,
+                                   conversions.leading_coordinates(snapshot.obstacles.points, d))
+        return core.plan(workspace, conversions.leading_coordinates(checked.positions, d))
+
+    @staticmethod
+    def _answer(response: Any, gathered: checks.Gathered, checked: checks.Checked,
+                the_plan: core.Plan, settings: PlannerSettings, now_ns: int,
+                started: float) -> Outcome:
+        """Step 4: stamps, paths and the filled response; return the Outcome."""
+        planning_time = time.perf_counter() - started
+        start_ns = int(now_ns) + int(round(planning_time * 1e9))
+        max_speed = gathered.max_speed
+        if settings.core_variant not in SCHEDULES:
+            checks.check_poses(settings, gathered.counts[0], len(the_plan.times),
+                               gathered.samples_per_leg)
+        with np.errstate(over='ignore', divide='ignore', invalid='ignore'):
+            duration = the_plan.duration(max_speed)
+        checks.check_duration(duration, max_speed, start_ns)
+        samples = the_plan.sample(gathered.samples_per_leg, max_speed)
+        paths = conversions.plan_to_paths(samples, checked.orientations, settings.frame_id,
+                                          start_ns, settings.plane_z)
+        conversions.fill_response(response, the_plan, paths, planning_time, max_speed,
+                                  samples.waypoints, checked.dropped)
+        return Outcome(response=response, plan=the_plan, paths=paths,
+                       names=conversions.robot_names(settings.robot_names, gathered.counts[0]),
+                       start_ns=start_ns, max_speed=max_speed, dropped=checked.dropped)

@@ -1,0 +1,54 @@
+"""
+What the planner publishes for a plan: the list of latched messages.
+
+The node and the MCAP recording both take :func:`plan_messages`, so a plan
+looks the same on the topics and in a recording. Conversions of single
+messages are in :mod:`punctured_planner.ros.conversions`, the markers in
+:mod:`punctured_planner.ros.markers`.
+"""
+
+from dataclasses import dataclass
+
+from nav_msgs.msg import Path
+from rclpy.serialization import serialize_message
+from std_msgs.msg import UInt32
+from visualization_msgs.msg import MarkerArray
+
+from .conversions import domain_index_message
+from .conversions import plan_message
+from .markers import plan_markers
+
+
+@dataclass(frozen=True)
+class Publication:
+    """One message to publish: relative topic, message type, the message or its CDR bytes."""
+
+    topic: str
+    msg_type: type
+    data: object
+
+    def serialized(self):
+        """Return the message as CDR bytes (as published)."""
+        if isinstance(self.data, bytes):
+            return self.data
+        return serialize_message(self.data)
+
+
+def plan_messages(outcome, settings):
+    """
+    Return the Publications of a successful planning Outcome, as the node publishes them.
+
+    Topics are relative: ``<robot>/plan`` per robot (the bytes built with the
+    response's Paths, :func:`punctured_planner.ros.conversions.plan_to_paths`),
+    ``plan_markers``, ``domain_index``, then ``plan`` (the Plan message, last: an
+    executor never sees a plan whose paths are not out).
+    """
+    messages = [Publication('%s/plan' % name.strip('/'), Path, data)
+                for name, data in zip(outcome.names, outcome.paths.serialized)]
+    messages.append(Publication('plan_markers', MarkerArray, plan_markers(
+        outcome.plan, settings.frame_id, outcome.start_ns, settings.plane_z, outcome.names,
+        outcome.max_speed)))
+    messages.append(Publication('domain_index', UInt32, domain_index_message(outcome.plan)))
+    plan = plan_message(outcome, settings)
+    messages.append(Publication('plan', type(plan), plan))
+    return messages

@@ -1,0 +1,54 @@
+"""
+How the ROS layer names configurations and obstacles in an error message: once, here.
+
+A :class:`~punctured_planner.core.errors.PlanningError` carries its culprits
+as numbers and its message as a template (see core/errors.py); the service
+response words it with :class:`RequestNames`: a configuration by its label in
+the request (the current state first, with use_current_state) and an obstacle
+by its index, position and source. The core numbers only the configurations
+it plans; ``planned`` maps them back to the request's.
+"""
+
+from typing import Callable
+from typing import Sequence
+
+from .snapshot import ObstacleSet
+from ..core.errors import Names
+
+
+class ObstacleNames(Names):
+    """Obstacles by index, position and source (the node's obstacle set)."""
+
+    def __init__(self, obstacles: ObstacleSet) -> None:
+        """Name the obstacles of ``obstacles``."""
+        self._obstacles = obstacles
+
+    def obstacle(self, j: int, point: object = None) -> str:
+        """Return 'obstacle j at (x, y, z) (from <source>)'."""
+        return self._obstacles.name(j)
+
+    def obstacles(self, indices: tuple[int, ...]) -> str:
+        """Return the names of several obstacles, joined by 'and'."""
+        return ' and '.join(self._obstacles.name(j) for j in indices)
+
+
+class RequestNames(ObstacleNames):
+    """Configurations by their label in the request, obstacles as :class:`ObstacleNames`."""
+
+    def __init__(self, obstacles: ObstacleSet, label: Callable[[int], str],
+                 planned: Sequence[int] | None = None) -> None:
+        """label(m) names request configuration m; planned[i] is the i-th planned one's m."""
+        super().__init__(obstacles)
+        self._label = label
+        self._planned = planned
+
+    def _request_index(self, m: int) -> int:
+        return m if self._planned is None else self._planned[m]
+
+    def configuration(self, m: int) -> str:
+        """Return the label of the request configuration the core's m is."""
+        return self._label(self._request_index(m))
+
+    def waypoint(self, m: int) -> str:
+        """Return C_{i+1} for the request configuration i the core's m is."""
+        return 'C_%d' % (self._request_index(m) + 1)
