@@ -42,9 +42,11 @@ hung now and then, and segfaulted about once in 26 stops. Here instead:
    finishes its callback in flight and returns; the threads are joined. Only
    then are the executors shut down, the group's ``before_teardown`` hook run
    (the executor leaves its robots stopped), the nodes destroyed (in reverse
-   order) and the Context shut down: :func:`_teardown`, the one place every
-   step after the spinning lives (a later "deliver the replies in flight
-   before the participant goes" step goes there too).
+   order) and the Context shut down. Every step between the stop and the
+   destruction lives in one place, :meth:`ExecutorThreads.close`, which
+   :func:`run_nodes` and the in-process tests share: a later "keep the
+   participant until the replies in flight are delivered, or a bounded grace
+   period passed" step goes there, after the hook and before the nodes go.
 
 A callback that raises stops the process the same way, with the traceback
 logged and exit code 1. A callback still running ``timeout_sec`` after the
@@ -230,7 +232,7 @@ class ExecutorThreads:
     def close(self, timeout_sec: float = STOP_TIMEOUT_SEC,
               before_teardown: Optional[Callable[[], None]] = None) -> bool:
         """
-        stop(), run before_teardown, destroy the nodes in reverse order.
+        stop(), run before_teardown, destroy the nodes in reverse order: the whole teardown.
 
         Return False (and leave everything as it is) if stop() failed.
         """
@@ -275,7 +277,7 @@ def run_nodes(name: str, make_nodes: Callable[[Context], NodeGroup],
 
 def _teardown(threads: ExecutorThreads, group: NodeGroup, timeout_sec: float) -> None:
     """
-    Every step after the stop signal, in order: stop spinning, the hook, destroy the nodes.
+    Tear the nodes down after the stop signal (ExecutorThreads.close), or exit if stuck.
 
     A callback still running ``timeout_sec`` after the signal cannot be
     stopped from Python: the stuck nodes are logged and the process ends with
