@@ -8,6 +8,7 @@ from punctured_planner.ros.planning import PlanSequenceHandler
 from punctured_planner.ros.settings import PLANNER
 from punctured_planner.ros.snapshot import ObstacleSet
 from punctured_planner.ros.snapshot import Snapshot
+import pytest
 
 
 def snapshot(**values):
@@ -196,3 +197,28 @@ def test_bundled_scenario_refuses_a_goal_grazing_an_obstacle():
     assert outcome.response.error_code == 12, outcome.response.error_msg
     assert outcome.response.min_gap < settings.required_clearance
     assert answer(make_request(), snapshot, 0).ok
+
+
+def test_errors_carry_their_culprits_and_are_worded_by_the_layer_that_answers():
+    """The core's error names obstacles its way; the response names them the node's way."""
+    from punctured_planner.core import PlanningError
+    from punctured_planner.core import Workspace
+    from punctured_planner.ros.wording import ObstacleNames
+    points = np.array([[0.0, 1.0], [2.0, 0.0], [0.0, 1.0]])
+    with pytest.raises(PlanningError) as refused:
+        Workspace(points)
+    error = refused.value
+    assert error.obstacles == (0, 2) and error.obstacle == 0
+    assert str(error) == 'OBSTACLES_DEGENERATE: obstacles 0 and 2 are at the same point'
+    named = ObstacleSet(np.c_[points, np.zeros(3)], source='/fleet/obstacles')
+    assert error.describe(ObstacleNames(named)) == (
+        'obstacle 0 at (0, 1, 0) (from topic /fleet/obstacles) and obstacle 2 at (0, 1, 0) '
+        '(from topic /fleet/obstacles) are at the same point')
+
+
+def test_free_text_in_a_message_is_never_read_as_a_slot():
+    """A frame id with braces is quoted as it is (the message is a template)."""
+    outcome = answer(make_request(frame_id='{configuration}'), snapshot(), 0)
+    assert outcome.response.error_code == 7
+    assert outcome.response.error_msg == (
+        "configuration 0 is in frame '{configuration}', the planning frame is 'map'")

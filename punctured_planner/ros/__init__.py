@@ -1,11 +1,12 @@
 """
 The ROS layer that is not a node: QoS, conversions, parameters, publications, the runtime.
 
-``qos`` (the topics' QoS profiles), ``conversions`` (every message <-> numpy
-conversion and message builder), ``parameters`` (the parameter machinery and
-each node's table), ``planning`` with ``snapshot``, ``checks`` and ``wording``
-(one PlanSequence request against one snapshot), ``publications`` and
-``markers`` (what a plan publishes), ``recording`` (MCAP), ``msg_dict``
-(YAML <-> messages) and ``runtime`` (start, spin, stop a node process).
-The nodes themselves are in :mod:`punctured_planner.nodes`.
+``runtime`` (start, spin and stop a node process), ``qos`` (the topics' QoS
+profiles), ``parameters`` (the parameter machinery) and ``settings`` (each
+node's table), ``conversions`` and ``cdr`` (every message <-> numpy
+conversion and message builder), ``snapshot``, ``checks``, ``wording`` and
+``planning`` (one PlanSequence request against one snapshot), ``goals``
+(plan_executor's plans and robot state), ``publications`` and ``markers``
+(what a plan publishes), ``recording`` (MCAP) and ``msg_dict`` (YAML <->
+messages). The nodes themselves are in :mod:`punctured_planner.nodes`.
 """
