@@ -12,7 +12,7 @@ the obstacles' positions and source) for a service response. Free text put
 into a template goes through :func:`literal`.
 """
 
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable
 import enum
 from typing import Any
 
@@ -66,14 +66,15 @@ class Names:
         return 'obstacles ' + ' and '.join(str(j) for j in indices)
 
 
-class _Slots(Mapping):
-    """The slot values of one error's template, computed for the slots it has."""
+class _Slots(dict):
+    """The slot values of one error's template, each computed when the template asks."""
 
     def __init__(self, error: 'PlanningError', names: Names) -> None:
+        super().__init__()
         self._error = error
         self._names = names
 
-    def __getitem__(self, slot: str) -> str:
+    def __missing__(self, slot: str) -> str:
         error, names = self._error, self._names
         if slot == 'configuration':
             return names.configuration(int(error.configuration))  # type: ignore[arg-type]
@@ -85,12 +86,6 @@ class _Slots(Mapping):
         if slot == 'obstacles':
             return names.obstacles(error.obstacles)
         raise KeyError(slot)
-
-    def __iter__(self):
-        return iter(('configuration', 'waypoint', 'next_waypoint', 'obstacle', 'obstacles'))
-
-    def __len__(self) -> int:
-        return 5
 
 
 class PlanningError(ValueError):
