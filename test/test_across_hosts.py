@@ -44,6 +44,11 @@ DISCOVERY_TIMEOUT_SEC = 60.0
 CALL_TIMEOUT_SEC = 30.0
 GOAL_TIMEOUT_SEC = 120.0
 CLIENT_TIMEOUT_SEC = 2 * DISCOVERY_TIMEOUT_SEC + 2 * CALL_TIMEOUT_SEC + GOAL_TIMEOUT_SEC
+DISCOVERY_PARAMETERS = """
+/**/plan_executor:
+  ros__parameters:
+    discovery_timeout: %.1f
+"""
 # After a goal, every robot is at most this far from its goal (m), as over one host.
 ARRIVAL_TOLERANCE = 0.02
 
@@ -144,11 +149,14 @@ def test_plan_executed_across_two_hosts(hosts, mode, ros_env, tmp_path):
     namespace = '/pp_hosts_%d' % os.getpid()
     params = tmp_path / 'execution.yaml'
     params.write_text(PARAMETERS, encoding='utf-8')
+    # the executor waits for odometry from the other host as long as the client does (its
+    # odometry subscriptions may match seconds after the client's). A second parameter
+    # file overrides the first's /**/plan_executor entry; `-p` loses to it (measured).
+    waits = tmp_path / 'discovery.yaml'
+    waits.write_text(DISCOVERY_PARAMETERS % DISCOVERY_TIMEOUT_SEC, encoding='utf-8')
     env = {host: dict(ros_env, FASTDDS_BUILTIN_TRANSPORTS='UDPv4', **discovery_env(mode, host))
            for host in (control, robots)}
     placement = {'planner_node': control, 'plan_executor': control, 'fleet_sim': robots}
-    # the executor waits for odometry from the other host as long as the client does
-    extra = {'plan_executor': ['-p', 'discovery_timeout:=%.1f' % DISCOVERY_TIMEOUT_SEC]}
     scenario = {'robot_names': NAMES, 'frame_id': 'map', 'goal': GOAL,
                 'discovery_timeout': DISCOVERY_TIMEOUT_SEC, 'call_timeout': CALL_TIMEOUT_SEC,
                 'goal_timeout': GOAL_TIMEOUT_SEC}
@@ -158,7 +166,7 @@ def test_plan_executed_across_two_hosts(hosts, mode, ros_env, tmp_path):
         for name, host in placement.items():
             processes[name] = in_netns(
                 host, [venv_script(name), '--ros-args', '-r', '__ns:=' + namespace,
-                       '--params-file', str(params), *extra.get(name, [])],
+                       '--params-file', str(params), '--params-file', str(waits)],
                 env[host], tmp_path / (name + '.log'), namespace)
         client = in_netns(control, [sys.executable, os.path.join(HERE, 'across_hosts_client.py'),
                                     namespace, json.dumps(scenario)],
