@@ -10,10 +10,11 @@ their public names under NAMESPACE. The scenario is JSON: ``{"robot_names": [...
 
 It waits for ``plan_sequence``, ``execute_plan`` and every robot's odometry, plans
 from the robots' current state to the goal, executes that plan, and prints one JSON
-line: ``{"plan": {...}, "result": {...}, "positions": [[x, y, z], ...], "true_gap",
-"odometry": {"messages", "bytes"}, "commands": {"messages", "bytes"}}``. Odometry and
-commands are counted as their serialized (CDR) payloads: the odometry comes from the
-simulator on the other host, so every byte of it crossed the link between the hosts.
+line: ``{"plan": {...}, "goal_refusals": [...], "result": {...}, "positions": [[x, y,
+z], ...], "true_gap", "odometry": {"messages", "bytes"}, "commands": {"messages",
+"bytes"}}``. Odometry and commands are counted as their serialized (CDR) payloads: the
+odometry comes from the simulator on the other host, so every byte of it crossed the
+link between the hosts.
 When something does not come up in time it prints ``{"error": "..."}`` and exits 1.
 """
 
@@ -23,6 +24,8 @@ import time
 
 # Settling time after the goal's result, so that the last odometry is the final state.
 SETTLE_SEC = 0.3
+# Pause before asking again for a plan the executor has not heard of yet.
+NO_PLAN_RETRY_SEC = 0.5
 
 
 class Fleet:
@@ -141,9 +144,35 @@ def plan(fleet, goal, scenario):
         fleet.spin_until(lambda: False, 0.2)
 
 
+def execute(fleet, plan_id, scenario, refusals):
+    """
+    Execute plan ``plan_id``; return its result, or the reason there is none.
+
+    The executor hears of a plan on the ``plan`` topic, which may match or arrive after
+    the response that named it (measured: "no plan received yet" once in 12 runs):
+    NO_PLAN is asked again until the call timeout, each refusal kept in ``refusals``.
+    """
+    from punctured_planner_interfaces.action import ExecutePlan
+    deadline = time.monotonic() + scenario['call_timeout']
+    while True:
+        sent = fleet.action.send_goal_async(ExecutePlan.Goal(plan_id=plan_id))
+        if not fleet.spin_until(sent.done, scenario['call_timeout']):
+            return 'execute_plan did not answer the goal'
+        handle = sent.result()
+        if not handle.accepted:
+            return 'execute_plan refused the goal'
+        result_future = handle.get_result_async()
+        if not fleet.spin_until(result_future.done, scenario['goal_timeout']):
+            return 'no result within %.0f s' % scenario['goal_timeout']
+        result = result_future.result().result
+        if result.error_code != ExecutePlan.Result.NO_PLAN or time.monotonic() > deadline:
+            return result
+        refusals.append(result.error_msg)
+        fleet.spin_until(lambda: False, NO_PLAN_RETRY_SEC)
+
+
 def run(fleet, scenario):
     """Discover, plan, execute; return the report (a JSON-ready dict)."""
-    from punctured_planner_interfaces.action import ExecutePlan
     wait = scenario['discovery_timeout']
     if not fleet.plan_sequence.wait_for_service(timeout_sec=wait):
         return {'error': 'plan_sequence not discovered within %.0f s' % wait}
@@ -159,19 +188,13 @@ def run(fleet, scenario):
     report = {'plan': {'error_code': response.error_code, 'error_msg': response.error_msg,
                        'plan_id': response.plan_id, 'min_gap': response.min_gap,
                        'tracking_tolerance': response.tracking_tolerance,
-                       'duration': seconds(response.duration)}}
+                       'duration': seconds(response.duration)},
+              'goal_refusals': []}
     if response.error_code != 0:
         return report
-    sent = fleet.action.send_goal_async(ExecutePlan.Goal(plan_id=response.plan_id))
-    if not fleet.spin_until(sent.done, scenario['call_timeout']):
-        return dict(report, error='execute_plan did not answer the goal')
-    handle = sent.result()
-    if not handle.accepted:
-        return dict(report, error='execute_plan refused the goal')
-    result_future = handle.get_result_async()
-    if not fleet.spin_until(result_future.done, scenario['goal_timeout']):
-        return dict(report, error='no result within %.0f s' % scenario['goal_timeout'])
-    result = result_future.result().result
+    result = execute(fleet, response.plan_id, scenario, report['goal_refusals'])
+    if isinstance(result, str):
+        return dict(report, error=result)
     fleet.spin_until(lambda: False, SETTLE_SEC)
     report['result'] = {'error_code': result.error_code, 'error_msg': result.error_msg,
                         'executed_duration': seconds(result.executed_duration),

@@ -207,10 +207,10 @@ def test_plan_executed_across_two_hosts(hosts, mode, ros_env, tmp_path):
     print('across hosts (%s): veth robots -> control %d B (odometry payload %d B in %d '
           'messages), control -> robots %d B (commands %d B in %d); true gap %.4f m, plan '
           'gap %.4f m; goal errors %s m; executed %.2f s (plan %.2f s); tracking errors %s m '
-          '(tolerance %.3f m)'
+          '(tolerance %.3f m); goals refused first: %s'
           % (mode, sent, odometry['bytes'], odometry['messages'], received,
              commands['bytes'], commands['messages'], report['true_gap'],
              report['plan']['min_gap'], np.round(arrival, 4).tolist(),
              report['result']['executed_duration'], report['plan']['duration'],
              np.round(report['result']['max_tracking_errors'], 3).tolist(),
-             report['plan']['tracking_tolerance']))
+             report['plan']['tracking_tolerance'], report['goal_refusals']))
