@@ -63,6 +63,7 @@ from .planning import ObstacleSet
 from .planning import PlanSequenceHandler
 from .planning import RobotState
 from .planning import Snapshot
+from .service_qos import SERVER_QOS
 from .shutdown import run_nodes
 
 
@@ -122,7 +123,7 @@ class PlannerNode(Node):
                                 ('plan', Plan)):
             self._publisher(topic, msg_type)
         self._service = self.create_service(PlanSequence, 'plan_sequence',
-                                            self._on_plan_sequence)
+                                            self._on_plan_sequence, qos_profile=SERVER_QOS)
         s = self._settings
         self.get_logger().info(
             'serving %s: frame %s, dimension %d, variant %s, robot radius %g, %s, robots %s'
