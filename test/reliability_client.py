@@ -68,13 +68,14 @@ def main(argv):
     import rclpy
     from rclpy.executors import SingleThreadedExecutor
 
+    from punctured_planner.service_qos import CLIENT_QOS
     from punctured_planner_interfaces.srv import PlanSequence
     context = rclpy.context.Context()
     rclpy.init(context=context, args=[])
     node = rclpy.create_node('reliability_client', context=context)
     executor = SingleThreadedExecutor(context=context)
     executor.add_node(node)
-    client = node.create_client(PlanSequence, service)
+    client = node.create_client(PlanSequence, service, qos_profile=CLIENT_QOS)
     lost = 0
     try:
         if not client.wait_for_service(timeout_sec=DISCOVERY_TIMEOUT_SEC):

@@ -97,6 +97,12 @@ def service_type():
     return PlanSequence
 
 
+def plan_client(client, name):
+    """Return a PlanSequence client on the RosClient's node, with the clients' QoS."""
+    from punctured_planner.service_qos import CLIENT_QOS
+    return client.node.create_client(service_type(), name, qos_profile=CLIENT_QOS)
+
+
 def pose_array(points, frame_id='map'):
     """Return a geometry_msgs/PoseArray of (x, y, z) points."""
     return build_request({'configurations': [[frame_id, points]]}).configurations[0]
@@ -284,7 +290,7 @@ def node(module_dir):
 @pytest.fixture(scope='module')
 def service(node, client):
     """Return a discovered PlanSequence client of the module's node."""
-    handle = client.node.create_client(service_type(), node.name('plan_sequence'))
+    handle = plan_client(client, node.name('plan_sequence'))
     client.wait_for_service(handle, timeout_sec=30.0)
     return handle
 
@@ -595,7 +601,7 @@ def test_concurrent_clients_while_inputs_change_at_50_hz(module_dir, client):
     """4 processes x 250 calls, obstacles and states alternating: none lost, each consistent."""
     ns = namespace('load')
     process = start_node(module_dir, ns)
-    handle = client.node.create_client(service_type(), ns + '/plan_sequence')
+    handle = plan_client(client, ns + '/plan_sequence')
     client.wait_for_service(handle, timeout_sec=30.0)
     plain = spec_of(CONFIGURATIONS, samples_per_leg=0)
     with_state = spec_of(CONFIGURATIONS[1:], samples_per_leg=0, use_current_state=True)
@@ -669,7 +675,7 @@ def test_restart_clients_recover_and_latched_plans_come_only_after_a_new_plan(
     from punctured_planner.planner_node import LATCHED
     ns = namespace('restart')
     first = start_node(module_dir, ns)
-    handle = client.node.create_client(service_type(), ns + '/plan_sequence')
+    handle = plan_client(client, ns + '/plan_sequence')
     client.wait_for_service(handle, timeout_sec=30.0)
     before = wait_until_planned(client, handle, spec_of(CONFIGURATIONS))
     early = []
