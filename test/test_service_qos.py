@@ -110,3 +110,42 @@ def test_requests_waiting_while_the_node_is_stopped_are_all_answered(
         '%d of %d answered in %.1f s:\n%s' % (len(answered), WAITING_REQUESTS,
                                               time.monotonic() - started, node.log()))
     node.assert_running()
+
+
+def test_every_reply_that_cannot_be_sent_is_an_error_naming_its_request(
+        planner_process, clients):
+    """A client whose reply reader never matches: each attempt of each reply is logged."""
+    from punctured_planner.planner_node import SEND_ATTEMPTS
+    from punctured_planner.service_qos import CLIENT_QOS
+    from punctured_planner_interfaces.srv import PlanSequence
+    from rclpy.qos import DurabilityPolicy
+    from rclpy.qos import QoSProfile
+    node = planner_process(params_file=SCENARIO)
+    request = example_request()
+    # Transient-local requests match the node's volatile request reader; the node's
+    # volatile reply writer never matches a transient-local reply reader.
+    unmatched = QoSProfile(depth=10, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+    deaf = clients('deaf')
+    deaf_client = deaf.node.create_client(PlanSequence, node.name('plan_sequence'),
+                                          qos_profile=unmatched)
+    served = clients('served')
+    served_client = plan_client(served, node, CLIENT_QOS)
+    assert served.call(served_client, request).error_code == PlanSequence.Response.NONE
+    futures = []
+    for number in (2, 3):
+        while 'plan_sequence #%d: ' % number not in node.log():
+            futures.append(deaf_client.call_async(request))
+            deaf.spin_until(lambda: False, 0.5)
+    last = 'plan_sequence #3: reply (error code 0) not sent to the client'
+    assert deaf.spin_until(lambda: ('attempt %d of %d' % (SEND_ATTEMPTS, SEND_ATTEMPTS)) in
+                           node.log().split(last)[-1], 10.0), node.log()
+    assert served.call(served_client, request).error_code == PlanSequence.Response.NONE
+    log = node.log()
+    for number in (2, 3):
+        lines = [line for line in log.splitlines()
+                 if 'plan_sequence #%d: reply (error code 0) not sent' % number in line]
+        assert len(lines) == SEND_ATTEMPTS, log
+        assert all(line.startswith('[ERROR]') for line in lines), lines
+    assert not any(f.done() for f in futures)
+    assert 'Traceback' not in log
+    node.assert_running()
