@@ -642,6 +642,7 @@ def test_concurrent_clients_while_inputs_change_at_50_hz(module_dir, client):
     rate = publisher.count / publisher.elapsed
     assert rate > 0.8 * PUBLISH_HZ, 'published at only %.1f Hz' % rate
     assert 'Traceback' not in process.log()
+    assert 'not sent to the client' not in process.log(), 'the node dropped a reply'
     process.stop()
     print('load: %d calls in %.2f s, %.1f Hz publishing, snapshots %s, p50 %.2f ms, '
           'max %.2f ms' % (len(latencies), elapsed, rate, snapshots,
