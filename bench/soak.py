@@ -116,6 +116,7 @@ class Soak:
     def __init__(self, node, executor, namespace, pid, args):
         """Create the client and the publishers."""
         from geometry_msgs.msg import PoseArray
+        from punctured_planner.ros.qos import CLIENT_QOS
         from punctured_planner_interfaces.srv import PlanSequence
         from rclpy.qos import DurabilityPolicy
         from rclpy.qos import QoSProfile
@@ -125,7 +126,8 @@ class Soak:
         self.executor = executor
         self.pid = pid
         self.args = args
-        self.client = node.create_client(PlanSequence, namespace + '/plan_sequence')
+        self.client = node.create_client(PlanSequence, namespace + '/plan_sequence',
+                                         qos_profile=CLIENT_QOS)
         self.obstacles = node.create_publisher(PoseArray, namespace + '/obstacles', latched)
         self.states = node.create_publisher(PoseArray, namespace + '/robot_states', 10)
         self.rng = np.random.default_rng(args.seed)

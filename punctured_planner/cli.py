@@ -101,13 +101,14 @@ def _request(args):
 
 
 def _call(args):
+    from punctured_planner.ros.qos import CLIENT_QOS
     from punctured_planner_interfaces.srv import PlanSequence
 
     request = _request(args)
     if request is None:
         return EXIT_USAGE
     with _ros_session() as (node, executor):
-        client = node.create_client(PlanSequence, args.service)
+        client = node.create_client(PlanSequence, args.service, qos_profile=CLIENT_QOS)
         if not client.wait_for_service(timeout_sec=args.wait):
             print('punctured-planner: service %s not available after %.1f s'
                   % (args.service, args.wait), file=sys.stderr)

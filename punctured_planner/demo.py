@@ -92,8 +92,9 @@ def _run(recorder, request_path, mcap_path, gif_path):
 
     from .cli import call_service
     from .ros.msg_dict import fill_message
+    from .ros.qos import CLIENT_QOS
     node = recorder.node
-    client = node.create_client(PlanSequence, 'plan_sequence')
+    client = node.create_client(PlanSequence, 'plan_sequence', qos_profile=CLIENT_QOS)
     action = ActionClient(node, ExecutePlan, 'execute_plan')
     if not (client.wait_for_service(timeout_sec=30) and action.wait_for_server(timeout_sec=30)
             and recorder.spin(lambda: len(recorder.odometry) == len(recorder.names), 30)):

@@ -4,8 +4,11 @@ A load-test client process: calls ``plan_sequence`` COUNT times and reports ever
 Usage: ``python reliability_client.py SERVICE COUNT REQUEST_JSON``. The request is
 JSON: ``{"configurations": [[frame_id, [[x, y, z], ...]], ...],
 "use_current_state": bool, "max_speed": float, "samples_per_leg": int}``, plus
-optional ``"call_timeout"`` (seconds per call, default 20) and ``"retry_lost"``
-(call again after a lost call until COUNT answers came, within 90 s).
+optional ``"call_timeout"`` (seconds per call, default 20), ``"retry_lost"``
+(call again after a lost call until COUNT answers came, within 90 s) and
+``"client_qos"``: ``"project"`` (default, punctured_planner.ros.qos.CLIENT_QOS)
+or ``"rclpy"`` (rclpy's default service QoS, depth 10; bench/load_stress.py
+compares the two).
 
 Each process has its own rclpy Context (a separate DDS participant). It prints one
 JSON line per call: ``{"i", "error_code", "error_msg", "domain_index",
@@ -68,13 +71,17 @@ def main(argv):
     import rclpy
     from rclpy.executors import SingleThreadedExecutor
 
+    from punctured_planner.ros.qos import CLIENT_QOS
     from punctured_planner_interfaces.srv import PlanSequence
+    from rclpy.qos import qos_profile_services_default
+    qos = {'project': CLIENT_QOS, 'rclpy': qos_profile_services_default}[
+        spec.get('client_qos', 'project')]
     context = rclpy.context.Context()
     rclpy.init(context=context, args=[])
     node = rclpy.create_node('reliability_client', context=context)
     executor = SingleThreadedExecutor(context=context)
     executor.add_node(node)
-    client = node.create_client(PlanSequence, service)
+    client = node.create_client(PlanSequence, service, qos_profile=qos)
     lost = 0
     try:
         if not client.wait_for_service(timeout_sec=DISCOVERY_TIMEOUT_SEC):

@@ -32,6 +32,7 @@ SIGTERM alike, threads joined before anything is destroyed):
 import sys
 import threading
 import traceback
+import warnings
 
 from geometry_msgs.msg import PoseArray
 from nav_msgs.msg import Odometry
@@ -48,6 +49,7 @@ from ..ros import publications
 from ..ros.parameters import NodeParameters
 from ..ros.planning import PlanSequenceHandler
 from ..ros.qos import LATCHED
+from ..ros.qos import SERVER_QOS
 from ..ros.qos import STATE
 from ..ros.runtime import NodeGroup
 from ..ros.runtime import run_nodes
@@ -59,6 +61,11 @@ from ..ros.snapshot import RobotState
 from ..ros.snapshot import Snapshot
 from ..ros.snapshot import take_snapshot
 from ..ros.wording import ObstacleNames
+# rmw_fastrtps waits up to 100 ms for the client's response reader to be matched,
+# then drops the reply; rclpy reports that with this warning (doc/design.md section 14).
+SEND_TIMEOUT_WARNING = 'failed to send response (timeout)'
+# Attempts at sending one reply: up to 1 s for a new client's reader to be matched.
+SEND_ATTEMPTS = 10
 
 
 class PlannerNode(Node):
@@ -95,7 +102,12 @@ class PlannerNode(Node):
                                 ('plan', Plan)):
             self._publisher(topic, msg_type)
         self._service = self.create_service(PlanSequence, 'plan_sequence',
-                                            self._on_plan_sequence)
+                                            self._on_plan_sequence, qos_profile=SERVER_QOS)
+        # The executor sends the callback's reply through this attribute: through
+        # _send_response, so that no reply is dropped without an error in the log.
+        self._send = self._service.send_response
+        self._service.send_response = self._send_response
+        self._answering = 0  # the number of the request whose reply is being sent
         s = self._settings
         self.get_logger().info(
             'serving %s: frame %s, dimension %d, variant %s, robot radius %g, %s, robots %s'
@@ -180,7 +192,7 @@ class PlannerNode(Node):
         now_ns = self.get_clock().now().nanoseconds
         snapshot = self.snapshot()
         self._request_count += 1
-        number = self._request_count
+        number = self._answering = self._request_count
         logger = self.get_logger()
         logger.info('plan_sequence #%d: %d configurations%s; snapshot: %s'
                     % (number, len(request.configurations),
@@ -212,6 +224,35 @@ class PlannerNode(Node):
             logger.warning('plan_sequence #%d: error %d: %s'
                            % (number, response.error_code, response.error_msg))
         return response
+
+    def _send_response(self, response, header):
+        """
+        Send the reply to request #self._answering; log each failed attempt, retry a bounded time.
+
+        rclpy turns the rmw's "client will not receive response" into a RuntimeWarning
+        that Python shows once; here every one is an error naming the request.
+        warnings.catch_warnings is process-wide: a warning of another thread in this
+        short window is shown again below, not lost.
+        """
+        number, sequence = self._answering, header.request_id.sequence_number
+        for attempt in range(1, SEND_ATTEMPTS + 1):
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter('always')
+                self._send(response, header)
+            failed = [w for w in caught if SEND_TIMEOUT_WARNING in str(w.message)]
+            for other in caught:
+                if other not in failed:
+                    warnings.showwarning(other.message, other.category, other.filename,
+                                         other.lineno)
+            if not failed:
+                self.get_logger().debug('plan_sequence #%d: reply sent (client sequence '
+                                        'number %d, attempt %d)' % (number, sequence, attempt))
+                return
+            self.get_logger().error(
+                'plan_sequence #%d: reply (error code %d) not sent to the client (sequence '
+                'number %d), attempt %d of %d: %s'
+                % (number, response.error_code, sequence, attempt, SEND_ATTEMPTS,
+                   failed[0].message))
 
     def _publish(self, outcome, settings):
         """Publish the complete plan: every robot's Path, stale robots emptied, markers, index."""

@@ -5,6 +5,18 @@ The QoS profiles of the package's topics, one place for every node and client.
 obstacles and the simulator's true gap; a late subscriber still gets the
 latest message. ``STATE``: robot state streams (odometry, ``robot_states``);
 best effort matches reliable and best-effort publishers alike.
+
+``SERVER_QOS`` and ``CLIENT_QOS``: the ``plan_sequence`` service, the node's and
+its clients' (doc/design.md section 14). rmw_fastrtps (Jazzy) carries a service
+on two DDS topics. The server has one response writer, and the response reader
+of every client of the service is matched with it: every reply reaches every
+client, and each client takes and drops the replies meant for the others. A
+reader keeps what it has not taken yet in a KEEP_LAST history of the QoS depth
+(10 in rclpy's default service QoS), and a full history silently drops its
+oldest sample. So a client that does not take for as long as the node answers 10
+calls of other clients loses its own reply; the same depth bounds the requests
+waiting in the node's request reader, and the replies its writer keeps for
+repairs.
 """
 
 from rclpy.qos import DurabilityPolicy
@@ -20,3 +32,23 @@ STATE = QoSProfile(depth=1, history=HistoryPolicy.KEEP_LAST,
                    durability=DurabilityPolicy.VOLATILE)
 # Commands and references: a short queue, reliable (the rclpy default for a depth).
 COMMANDS = 10
+
+# The node: requests that may wait while it plans (one client's call each), and
+# replies kept for repairs. Bounded: a reply stays until every matched client
+# acknowledged it, so a crashed client holds this many replies until its lease ends.
+SERVER_DEPTH = 100
+# A client: replies to all clients that may arrive before it takes its own. A
+# client process stalled for 1 s while the node answered 300 calls per second
+# needs 300; the replies it holds are dropped as it takes them.
+CLIENT_DEPTH = 1000
+
+
+def _service_qos(depth: int) -> QoSProfile:
+    """Return rclpy's service QoS (reliable, volatile, keep last) with ``depth``."""
+    return QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=depth,
+                      reliability=ReliabilityPolicy.RELIABLE,
+                      durability=DurabilityPolicy.VOLATILE)
+
+
+SERVER_QOS = _service_qos(SERVER_DEPTH)
+CLIENT_QOS = _service_qos(CLIENT_DEPTH)

@@ -1,0 +1,151 @@
+"""
+No reply or request of ``plan_sequence`` is dropped by a DDS history (issue 21).
+
+rmw_fastrtps delivers every reply of a service to every client of it; each
+client's reader keeps the replies it has not taken in a KEEP_LAST history
+(doc/design.md section 14). These tests stall one side for longer than
+rclpy's default depth of 10 and check that nothing is lost with the QoS of
+:mod:`punctured_planner.ros.qos`; the default QoS beside it loses the reply,
+which is the cause of the lost call of issue 21.
+"""
+
+import os
+import signal
+import time
+
+from conftest import REPO_ROOT
+from conftest import RosClient
+import pytest
+import yaml
+
+pytestmark = [pytest.mark.ros, pytest.mark.slow]
+
+SCENARIO = os.path.join(REPO_ROOT, 'config', 'default_scenario.yaml')
+EXAMPLE = os.path.join(REPO_ROOT, 'config', 'example_request.yaml')
+# More than rclpy's default service depth (10), well under the depths of ros.qos.
+OTHER_CALLS = 30
+WAITING_REQUESTS = 30
+
+
+def example_request():
+    """Return config/example_request.yaml as a PlanSequence request."""
+    from punctured_planner.ros.msg_dict import fill_message
+    from punctured_planner_interfaces.srv import PlanSequence
+    with open(EXAMPLE, encoding='utf-8') as stream:
+        return fill_message(PlanSequence.Request(), yaml.safe_load(stream))
+
+
+@pytest.fixture
+def clients():
+    """Yield a function making RosClients (each its own participant); all closed after."""
+    made = []
+
+    def make(name):
+        made.append(RosClient(name))
+        return made[-1]
+
+    yield make
+    for ros in made:
+        ros.close()
+
+
+def plan_client(ros, node, qos):
+    """Return a discovered PlanSequence client of ``node`` with ``qos``."""
+    from punctured_planner_interfaces.srv import PlanSequence
+    client = ros.node.create_client(PlanSequence, node.name('plan_sequence'), qos_profile=qos)
+    ros.wait_for_service(client, timeout_sec=30.0)
+    return client
+
+
+def test_a_stalled_client_keeps_its_reply_while_others_are_answered(
+        planner_process, clients):
+    """A client that takes nothing while 30 other calls are answered still gets its reply."""
+    from punctured_planner.ros.qos import CLIENT_QOS
+    from punctured_planner_interfaces.srv import PlanSequence
+    from rclpy.qos import qos_profile_services_default
+    node = planner_process(params_file=SCENARIO)
+    request = example_request()
+    stalled = {}
+    for name, qos in (('service_qos', CLIENT_QOS),
+                      ('rclpy_default', qos_profile_services_default)):
+        ros = clients('stalled_' + name)
+        stalled[name] = (ros, plan_client(ros, node, qos))
+    other = clients('other')
+    other_client = plan_client(other, node, CLIENT_QOS)
+    for ros, client in stalled.values():
+        assert ros.call(client, request).error_code == PlanSequence.Response.NONE
+    # Both send, then neither spins (takes) while the other client is answered.
+    futures = {name: client.call_async(request) for name, (_, client) in stalled.items()}
+    for _ in range(OTHER_CALLS):
+        assert other.call(other_client, request).error_code == PlanSequence.Response.NONE
+    got = {name: stalled[name][0].spin_until(future.done, 5.0)
+           for name, future in futures.items()}
+    assert got['service_qos'], 'the stalled client lost its reply:\n' + node.log()
+    assert futures['service_qos'].result().error_code == PlanSequence.Response.NONE
+    # The cause of issue 21, pinned: with rclpy's default depth the reply is dropped.
+    assert not got['rclpy_default'], 'depth 10 kept its reply: doc/design.md section 14'
+
+
+def test_requests_waiting_while_the_node_is_stopped_are_all_answered(
+        planner_process, clients):
+    """30 requests sent while the node process is frozen (SIGSTOP) are all answered."""
+    from punctured_planner.ros.qos import CLIENT_QOS
+    from punctured_planner_interfaces.srv import PlanSequence
+    node = planner_process(params_file=SCENARIO)
+    ros = clients('waiting')
+    client = plan_client(ros, node, CLIENT_QOS)
+    request = example_request()
+    assert ros.call(client, request).error_code == PlanSequence.Response.NONE
+    node.proc.send_signal(signal.SIGSTOP)
+    try:
+        futures = [client.call_async(request) for _ in range(WAITING_REQUESTS)]
+        ros.spin_until(lambda: False, 0.5)  # the requests go out; none can be answered
+        assert not any(f.done() for f in futures)
+    finally:
+        node.proc.send_signal(signal.SIGCONT)
+    started = time.monotonic()
+    ros.spin_until(lambda: all(f.done() for f in futures), 30.0)
+    answered = [f.result().error_code for f in futures if f.done()]
+    assert answered == [PlanSequence.Response.NONE] * WAITING_REQUESTS, (
+        '%d of %d answered in %.1f s:\n%s' % (len(answered), WAITING_REQUESTS,
+                                              time.monotonic() - started, node.log()))
+    node.assert_running()
+
+
+def test_every_reply_that_cannot_be_sent_is_an_error_naming_its_request(
+        planner_process, clients):
+    """A client whose reply reader never matches: each attempt of each reply is logged."""
+    from punctured_planner.nodes.planner import SEND_ATTEMPTS
+    from punctured_planner.ros.qos import CLIENT_QOS
+    from punctured_planner_interfaces.srv import PlanSequence
+    from rclpy.qos import DurabilityPolicy
+    from rclpy.qos import QoSProfile
+    node = planner_process(params_file=SCENARIO)
+    request = example_request()
+    # Transient-local requests match the node's volatile request reader; the node's
+    # volatile reply writer never matches a transient-local reply reader.
+    unmatched = QoSProfile(depth=10, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+    deaf = clients('deaf')
+    deaf_client = deaf.node.create_client(PlanSequence, node.name('plan_sequence'),
+                                          qos_profile=unmatched)
+    served = clients('served')
+    served_client = plan_client(served, node, CLIENT_QOS)
+    assert served.call(served_client, request).error_code == PlanSequence.Response.NONE
+    futures = []
+    for number in (2, 3):
+        while 'plan_sequence #%d: ' % number not in node.log():
+            futures.append(deaf_client.call_async(request))
+            deaf.spin_until(lambda: False, 0.5)
+    last = 'plan_sequence #3: reply (error code 0) not sent to the client'
+    assert deaf.spin_until(lambda: ('attempt %d of %d' % (SEND_ATTEMPTS, SEND_ATTEMPTS)) in
+                           node.log().split(last)[-1], 10.0), node.log()
+    assert served.call(served_client, request).error_code == PlanSequence.Response.NONE
+    log = node.log()
+    for number in (2, 3):
+        lines = [line for line in log.splitlines()
+                 if 'plan_sequence #%d: reply (error code 0) not sent' % number in line]
+        assert len(lines) == SEND_ATTEMPTS, log
+        assert all(line.startswith('[ERROR]') for line in lines), lines
+    assert not any(f.done() for f in futures)
+    assert 'Traceback' not in log
+    node.assert_running()
