@@ -1,16 +1,16 @@
 """
-The 'discs' variant: bodies never touch under the stated condition, and the paper's domains.
+The 'discs' variant: bodies keep a margin under the stated condition, and the paper's domains.
 
 The condition (punctured_planner/core/discs.py, doc/design.md section 6):
-robot centres at least S = max(4R, 2R + max w_j) apart, no disc overlapping a
-pillar, and pillar pairs meeting condition (c). The strategies build inputs
-that meet exactly that, adversarially: robots on a lattice of pitch exactly
-S (many pairs exactly S apart, many sharing projections with each other and
-with pillars), pillars on lattice cells, columns of robots between pillars,
-mirror-image goals.
+robot centres at least S = max(4R, 2R + nu + max w_j) apart, no disc
+overlapping a pillar, and pillar pairs meeting condition (c). The strategies
+(core_strategies.lattice_requests) build inputs that meet exactly that,
+adversarially: robots on a lattice of pitch exactly S (many pairs exactly S
+apart, many sharing projections with each other and with pillars), pillars on
+lattice cells, columns of robots between pillars, mirror-image goals.
 """
 
-from core_strategies import requests
+from core_strategies import lattice_requests, requests, separation
 from hypothesis import assume, given, HealthCheck, settings, strategies as st
 import numpy as np
 from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
@@ -19,13 +19,6 @@ import pytest
 
 PROPERTY = settings(max_examples=120, deadline=None,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
-
-
-def separation(workspace):
-    """Return S = max(4R, 2R + nu + max_j w_j), the theorem's robot spacing (design, 6)."""
-    radius = workspace.robot_radius
-    reach = workspace.disc_layout.reach.max(initial=0.0)
-    return max(4 * radius, (2 + MARGIN) * radius + reach)
 
 
 def keeps_margin(p):
@@ -43,40 +36,6 @@ def keeps_margin(p):
     margin = min(MARGIN * workspace.robot_radius, given)
     resolution = p.clearance.resolution
     return p.min_gap >= margin - resolution and (margin <= resolution or p.min_gap > 0)
-
-
-@st.composite
-def lattice_requests(draw):
-    """Return (workspace, configurations (n, k, 2)) meeting the theorem's condition exactly."""
-    radius = draw(st.sampled_from([0.1, 0.25, 0.3]))
-    columns, rows = draw(st.integers(2, 7)), draw(st.integers(2, 6))
-    cells = [(c, r) for c in range(columns) for r in range(rows)]
-    pillar_cells = draw(st.lists(st.sampled_from(cells), max_size=4, unique=True))
-    # Narrower than, as wide as and wider than the robots.
-    rho = [draw(st.sampled_from([0.0, 0.5, 0.8, 1.0, 1.5])) * radius for _ in pillar_cells]
-    # The lattice pitch is exactly S, which the pillars' radii fix (the theorem's (a)).
-    probe = np.stack([np.arange(len(rho)), np.zeros(len(rho))], axis=1)
-    pitch = separation(Workspace(probe, dimension=2, variant='discs', robot_radius=radius,
-                                 obstacle_radius=np.array(rho)))
-    free = [cell for cell in cells if cell not in pillar_cells]
-    assume(free)
-    k = draw(st.integers(1, min(len(free), 10)))
-    n = draw(st.integers(2, 3))
-    origin = np.array([draw(st.sampled_from([0.0, 0.37, -1.5])), 0.25])
-    chosen = [draw(st.permutations(free))[:k] for _ in range(n)]
-    mirror = [(columns - 1 - c, r) for c, r in chosen[0]]
-    if draw(st.booleans()) and not set(mirror) & set(pillar_cells):
-        chosen[-1] = mirror  # mirror-image goal: C_1 reflected through the lattice's middle
-    configurations = [origin + pitch * np.array(cells_, dtype=float) for cells_ in chosen]
-    pillars = origin + pitch * np.array(pillar_cells, dtype=float).reshape(-1, 2)
-    try:
-        workspace = Workspace(pillars, dimension=2, variant='discs', robot_radius=radius,
-                              obstacle_radius=np.array(rho))
-    except PlanningError as error:  # two pillars in one column share a projection
-        assume(error.code != ErrorCode.OBSTACLES_DEGENERATE)
-        raise
-    assume(len(workspace.disc_layout.conflicting_pillars(radius)) == 0)
-    return workspace, np.array(configurations)
 
 
 @PROPERTY

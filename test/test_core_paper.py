@@ -10,7 +10,7 @@ from punctured_planner.core.sections import PAPER_FRACTIONS
 import pytest
 
 # These tests check the construction itself (doc/design.md sections 3, 5), not its
-# refinement (section 10).
+# refinement (section 14).
 base = partial(plan, refine=False)
 
 WORKED_OBSTACLES = [[0.0, 0.0], [1.0, 0.0]]

@@ -11,7 +11,7 @@ from punctured_planner.core.deformations import pool_adjacent_violators, spread
 import pytest
 
 # These tests check the construction itself (doc/design.md sections 3, 5), not its
-# refinement (section 10).
+# refinement (section 14).
 base = partial(plan, refine=False)
 
 PROPERTY = settings(max_examples=150, deadline=None,

@@ -307,7 +307,7 @@ def _axis_plan(workspace, configurations, projections, gaps, counts):
 
 
 def _refined(raw):
-    """Return raw refined against its own exact gap (core.refine, doc/design.md section 10)."""
+    """Return raw refined against its own exact gap (core.refine, doc/design.md section 14)."""
     workspace = raw.workspace
     k = raw.positions.shape[1]
     radii = np.concatenate([np.full(k, workspace.robot_radius), workspace.obstacle_radii])

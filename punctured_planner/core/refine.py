@@ -1,5 +1,5 @@
 """
-The refinement: a continuous, certified shortening of every plan (doc/design.md section 10).
+The refinement: a continuous, certified shortening of every plan (doc/design.md section 14).
 
 The construction fixes which domain a request is in and which way round each
 robot goes; the geometry inside that is free. The refined motion is
@@ -12,18 +12,19 @@ at the configurations. y is piecewise linear on the union of x's breakpoints
 and the knots, so the certificate stays exact, and the configurations stay
 breakpoints, unchanged.
 
-delta is built by a fixed schedule of steps (LEVELS: K knots per segment,
-coarse to fine, a fixed number of steps each, a fixed step length). A step
-moves every knot towards a target, a mix of the midpoint of its neighbours and
-the straight chord C_m -> C_{m+1} at the knot's normalised time, clipped to
-the step length and to the knot's cap: over the legs its hat function covers,
-a quarter of the smallest slack (gap minus the margin g0, the construction's
-own exact min_gap) of any robot pair it belongs to there, and half of its
-smallest robot-pillar slack. Gap distance is 1-Lipschitz in each robot's
-position, so no gap falls below g0 (the caps lemma, doc/design.md section 10).
-Every quantity is a continuous function of the input, and the set of pairs a
-step checks changes only where the dropped pairs provably cannot bind (a reach
-bound over the remaining steps), so the map stays continuous on every domain.
+delta is built by a fixed schedule: BLOCKS blocks of SWEEPS red-black sweeps of
+over-relaxed smoothing (each knot towards its neighbours' midpoint). A block
+first computes every knot's caps from the exact slack (gap minus the margin
+g0, the construction's own exact min_gap) over the two knot intervals its hat
+function covers: a quarter of its smallest robot-pair slack, half of its
+smallest robot-pillar slack; each knot's total move in the block is split into
+the fleet's common translation (which robot pairs do not feel) and each
+robot's own part, each clipped to its caps and to a fixed step. Gap distance
+is 1-Lipschitz in each robot's position, so no gap falls below g0 (the caps
+lemma). Every quantity is a continuous function of the input; pairs are left
+out only where their cap term provably exceeds the step (so leaving them out
+changes nothing), and the number of blocks, sweeps and knots is fixed, so the
+map stays continuous on every domain (doc/design.md section 14).
 """
 
 from dataclasses import dataclass
@@ -35,22 +36,27 @@ from .certificate import certify, segment_minimum
 
 # Knots per segment: the field is piecewise linear on the j / KNOTS fractions.
 KNOTS = 64
-# A block computes the caps once (the costly part: exact slack of every pair near
-# enough to matter), then runs red-black sweeps of over-relaxed smoothing (successive
-# over-relaxation: O(KNOTS) sweeps where plain smoothing, like diffusion, needs
-# O(KNOTS^2)), each knot's total move in the block clipped to its cap. Fresh caps let
-# robots use the room they made, so many short blocks beat few long ones; the number of
-# blocks falls with k (fixed per domain, as k is) to bound the time: between
-# MIN_BLOCKS and MAX_BLOCKS, about BLOCK_BUDGET / k, and SWEEPS / blocks sweeps each.
-MIN_BLOCKS, MAX_BLOCKS, BLOCK_BUDGET, SWEEPS = 10, 60, 1200, 60
+# A block computes the caps once (the costly part: the exact slack of every pair near
+# enough to matter), then runs SWEEPS red-black sweeps of over-relaxed smoothing
+# (successive over-relaxation: O(KNOTS) sweeps where plain smoothing, like diffusion,
+# needs O(KNOTS^2)), each knot's total move in the block clipped to its caps. Fresh caps
+# let robots use the room they made, so more blocks shorten more; but a block's caps
+# follow the motion (a pillar cap moves by up to half of what the motion moves), so
+# each block can amplify a change of input, and BLOCKS bounds that (measured: a 1e-7
+# change moves the refined motion 5 - 22x that, the construction's 2 - 4x).
+BLOCKS, SWEEPS = 12, 6
 # The longest move of a knot in one block, as a share of the fleet's scale.
-STEP = 0.05
+STEP = 0.2
 # Over-relaxation factor: about 2 / (1 + sin(pi / KNOTS)) is the classical optimum; less
 # is steadier under the caps.
 RELAXATION = 1.9
 # Caps: a quarter of a robot pair's slack (each robot moves at most that, so the pair's
 # distance changes by at most half of it), half of a robot-pillar slack.
 PAIR_SHARE, PILLAR_SHARE = 0.25, 0.5
+# The common translation of a knot may be at most this multiple of its smallest pair cap
+# (4: the smallest pair slack itself; more would make the caps steep, and continuity
+# weaker, for nothing but rounding).
+_TRANSLATION = 4.0
 # Up to this many robots every pair is checked on every interval (pruning costs more).
 _ALL_PAIRS = 24
 
@@ -226,7 +232,7 @@ class _Caps:
     intervals each knot's hat covers; 0 at the configurations. A pair whose
     enclosing balls already keep a slack of 4 step is left out: its cap term
     would be at least step (2 step for a pillar), which the block's caps never
-    exceed, so leaving it out changes nothing (design, 10).
+    exceed, so leaving it out changes nothing (design, 14).
     """
 
     def __init__(self, motion, knots, bodies, step):
@@ -283,16 +289,22 @@ class _Block:
     """
     The moves of one block: the fleet's common translation and each robot's own part.
 
-    A common translation leaves every robot pair's distance as it is, so only
-    robot-pillar caps bound it: |common| <= half the smallest pillar cap of the
-    knot and <= step, |own| <= the pair cap, <= what common leaves of the pillar
-    cap and <= step. Both are totals over the block, so a robot's displacement
-    at any instant of the block stays within its caps (design, 10).
+    A common translation leaves every robot pair's distance as it is (up to
+    rounding), so robot-pillar caps bound it: |common| <= half the smallest
+    pillar cap of the knot, <= step, and <= _TRANSLATION x its smallest pair
+    cap (0 where a pair has no slack, so rounding cannot take any); |own| <=
+    the pair cap, <= what common leaves of the pillar cap and <= step. Both
+    are totals over the block, so a robot's displacement at any instant of the
+    block stays within its caps (design, 14).
     """
 
     def __init__(self, caps, step):
         """Fix the caps of the block."""
-        self.common_cap = np.minimum(0.5 * caps.pillar.min(axis=1), step)
+        # A translation keeps pair distances, but only up to rounding: where a pair has no
+        # slack the common part must be exactly 0. Capping it by a multiple of the
+        # smallest pair cap does that and stays continuous.
+        self.common_cap = np.minimum(np.minimum(0.5 * caps.pillar.min(axis=1), step),
+                                     _TRANSLATION * caps.pair.min(axis=1))
         self.pair, self.pillar, self.step = caps.pair, caps.pillar, step
 
     def clip(self, wanted):
@@ -340,7 +352,7 @@ def refine(times: np.ndarray, positions: np.ndarray, waypoint_indices: np.ndarra
 
     Every gap of the result stays >= bodies.margin, the configurations are its
     breakpoints exactly, and it is a continuous function of the input (module
-    docstring; doc/design.md section 10).
+    docstring; doc/design.md section 14).
     """
     k, d = positions.shape[1:]
     configurations = positions[waypoint_indices]
@@ -354,12 +366,11 @@ def refine(times: np.ndarray, positions: np.ndarray, waypoint_indices: np.ndarra
     base_knots = union.positions[knots.points]
     values = np.zeros((knots.times.size, k, d))
     motion = union.positions
-    blocks = int(np.clip(BLOCK_BUDGET // max(k, 1), MIN_BLOCKS, MAX_BLOCKS))
     step = STEP * scale
-    for _ in range(blocks):
+    for _ in range(BLOCKS):
         block = _Block(_Caps(motion, knots, bodies, step), step)
         common, own = np.zeros((values.shape[0], d)), np.zeros_like(values)
-        for _ in range(SWEEPS // blocks):
+        for _ in range(SWEEPS):
             common, own = _sweep(values, common, own, base_knots, block)
         values = values + common[:, None] + own
         # x + 0.0 is x: a robot held everywhere in an interval keeps x's breakpoints.
