@@ -281,7 +281,8 @@ def _knot_caps(bound):
 def _clipped(move, caps):
     """Return the moves (..., d) scaled down to lengths <= caps (...); zero at cap 0."""
     length = np.sqrt((move * move).sum(axis=-1))
-    scale = np.where(length > caps, caps / np.maximum(length, np.finfo(float).tiny), 1.0)
+    over = length > caps
+    scale = np.where(over, caps / np.where(over, length, 1.0), 1.0)
     return move * scale[..., None]
 
 
