@@ -21,7 +21,7 @@ from .certificate import certify, certify_bodies, Clearance, RELATIVE_RESOLUTION
 from .complexity import domain_range, sequential_complexity
 from .deformations import desingularize, desingularizing_shift, spread
 from .errors import ErrorCode, PlanningError
-from .refine import Bodies, refine as refine_motion, Refinement
+from .refine import block_count, Bodies, refine as refine_motion, Refinement
 from .sections import compose, lane_heights, SCHEDULES, segment_times
 from .space import Workspace
 from .strata import epsilon, projection_count, projection_gaps
@@ -307,7 +307,13 @@ def _axis_plan(workspace, configurations, projections, gaps, counts):
 
 
 def _refined(raw):
-    """Return raw refined against its own exact gap (core.refine, doc/design.md section 14)."""
+    """
+    Return raw refined against its own exact gap (core.refine, doc/design.md section 14).
+
+    Beyond refine.MAX_ROBOTS robots raw itself (its raw attribute None says so).
+    """
+    if block_count(raw.positions.shape[1]) == 0:
+        return raw
     workspace = raw.workspace
     k = raw.positions.shape[1]
     radii = np.concatenate([np.full(k, workspace.robot_radius), workspace.obstacle_radii])

@@ -45,6 +45,10 @@ KNOTS = 64
 # each block can amplify a change of input, and BLOCKS bounds that (measured: a 1e-7
 # change moves the refined motion 5 - 22x that, the construction's 2 - 4x).
 BLOCKS, SWEEPS = 12, 6
+# A block's cost grows like k^2 (all pairs near each other somewhere): beyond FULL_ROBOTS
+# robots the blocks fall as FULL_ROBOTS / k, and beyond MAX_ROBOTS none is run (the
+# construction's plan is returned; k is fixed on a domain, so this keeps continuity).
+FULL_ROBOTS, MAX_ROBOTS = 64, 256
 # The longest move of a knot in one block, as a share of the fleet's scale.
 STEP = 0.2
 # Over-relaxation factor: about 2 / (1 + sin(pi / KNOTS)) is the classical optimum; less
@@ -340,6 +344,13 @@ def _sweep(start, common, own, base_knots, block):
     return common, own
 
 
+def block_count(robot_count: int) -> int:
+    """Return the blocks for k robots: BLOCKS, fewer beyond FULL_ROBOTS, none beyond MAX."""
+    if robot_count > MAX_ROBOTS:
+        return 0
+    return max(1, BLOCKS * min(FULL_ROBOTS, robot_count) // max(robot_count, 1))
+
+
 def fleet_scale(configurations: np.ndarray, obstacles: np.ndarray) -> float:
     """Return the side of the box of the configurations and pillars: the steps' length unit."""
     points = np.concatenate([configurations.reshape(-1, configurations.shape[2]), obstacles])
@@ -368,7 +379,7 @@ def refine(times: np.ndarray, positions: np.ndarray, waypoint_indices: np.ndarra
     values = np.zeros((knots.times.size, k, d))
     motion = union.positions
     step = STEP * scale
-    for _ in range(BLOCKS):
+    for _ in range(block_count(k)):
         block = _Block(_Caps(motion, knots, bodies, step), step)
         common, own = np.zeros((values.shape[0], d)), np.zeros_like(values)
         for _ in range(SWEEPS):
