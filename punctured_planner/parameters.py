@@ -32,7 +32,7 @@ class Spec:
     """One parameter: its name, kind, default, range (inclusive) and description."""
 
     name: str
-    kind: str  # 'string', 'integer', 'double', 'string_array', 'double_array'
+    kind: str  # 'string', 'bool', 'integer', 'double', 'string_array', 'double_array'
     default: object
     description: str
     low: object = None
@@ -84,6 +84,10 @@ PARAMETERS = (
     Spec('required_clearance', 'double', 0.0,
          'Refuse a plan whose certified minimum clearance is below this (m); 0 accepts '
          'every collision-free plan.', low=0.0, high=1e6),
+    Spec('refine', 'bool', True,
+         "Refine the construction's motion (doc/design.md section 14): shorter, in the "
+         "same domain, its gap never below the construction's; false: the construction's "
+         'own motion.', constraints='true or false'),
     Spec('max_state_age', 'double', 0.5,
          'Largest age (s, by arrival on the node clock) of the robot state a '
          'use_current_state request may start from; older is refused (NO_ROBOT_STATE). '
@@ -128,6 +132,7 @@ class Settings:
     lane_spacing: float = 1.0
     min_spacing: float = 0.5
     required_clearance: float = 0.0
+    refine: bool = True
     max_state_age: float = 0.5
     repeat_tolerance: float = 1e-3
     max_speed: float = 1.0
@@ -164,6 +169,10 @@ def _coerce(spec, value):
     if spec.kind == 'string':
         if not isinstance(value, str):
             raise ValueError('%s must be a string, got %r' % (spec.name, value))
+        return value
+    if spec.kind == 'bool':
+        if not isinstance(value, bool):
+            raise ValueError('%s must be true or false, got %r' % (spec.name, value))
         return value
     if spec.kind == 'integer':
         if not isinstance(value, int) or isinstance(value, bool):
@@ -289,6 +298,7 @@ def descriptor(spec, read_only=False):
 
     kinds = {
         'string': ParameterType.PARAMETER_STRING,
+        'bool': ParameterType.PARAMETER_BOOL,
         'integer': ParameterType.PARAMETER_INTEGER,
         'double': ParameterType.PARAMETER_DOUBLE,
         'string_array': ParameterType.PARAMETER_STRING_ARRAY,

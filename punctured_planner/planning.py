@@ -355,16 +355,16 @@ class PlanSequenceHandler:
         d = snapshot.settings.dimension
         workspace = self.workspace(snapshot.settings,
                                    conversions.leading_coordinates(snapshot.obstacles.points, d))
-        return core_plan(workspace, conversions.leading_coordinates(checked.positions, d))
+        return core_plan(workspace, conversions.leading_coordinates(checked.positions, d),
+                         refine=snapshot.settings.refine)
 
     def _answer(self, response, gathered, checked, the_plan, settings, now_ns, started):
         """Step 4: stamps, paths and the filled response; return the Outcome."""
         planning_time = time.perf_counter() - started
         start_ns = int(now_ns) + int(round(planning_time * 1e9))
         max_speed = gathered.max_speed
-        if settings.core_variant not in SCHEDULES:
-            _check_poses(settings, gathered.counts[0], len(the_plan.times),
-                         gathered.samples_per_leg)
+        # The plan's own breakpoints: the refinement's knots add to any schedule's.
+        _check_poses(settings, gathered.counts[0], len(the_plan.times), gathered.samples_per_leg)
         self._check_duration(the_plan, max_speed, start_ns)
         samples = the_plan.sample(gathered.samples_per_leg, max_speed)
         paths = conversions.plan_to_paths(samples, checked.orientations, settings.frame_id,
@@ -390,7 +390,10 @@ class PlanSequenceHandler:
             _fail(ErrorCode.REQUEST_OVER_LIMITS, 'samples_per_leg %d is more than %d'
                   % (samples, MAX_SAMPLES_PER_LEG))
         schedule = SCHEDULES.get(settings.core_variant)
-        if schedule is not None:  # 'discs' has no fixed legs: checked once planned
+        # The construction's breakpoints, fewer than the refined plan's: an early refusal
+        # before planning; the answer's own count is checked once planned ('discs' has
+        # no fixed legs, so only then).
+        if schedule is not None:
             _check_poses(settings, k, schedule.breakpoint_count(n), samples)
 
     @staticmethod

@@ -8,7 +8,7 @@ from punctured_planner import fleet_sim_node
 from punctured_planner.parameters import PARAMETERS
 import pytest
 
-KINDS = {'string': 'string', 'integer': 'integer', 'double': 'double',
+KINDS = {'string': 'string', 'bool': 'bool', 'integer': 'integer', 'double': 'double',
          'string_array': 'string array', 'double_array': 'double array'}
 
 
