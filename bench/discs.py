@@ -10,7 +10,7 @@ same exact certificate (Plan.min_gap; OMPL's paths through its states as
 piecewise-linear synchronous motions); "gap >= 0" allows the rounding of the
 coordinates (the certificate's resolution, 1e-12 of their scale), as bodies
 that touch exactly come out a few ulps either side of 0. A second family meets the 'discs'
-theorem's condition exactly (robots on a lattice of pitch 4R, pillars on
+theorem's condition exactly (robots on a lattice of pitch S, pillars on
 lattice cells, pillar pairs checked against condition (c)).
 
 Run alone: ``.venv/bin/python bench/discs.py [--quick]``.
@@ -27,6 +27,7 @@ import peers
 
 from punctured_planner.core import plan, PlanningError, Workspace
 from punctured_planner.core.certificate import certify
+from punctured_planner.core.discs import MARGIN
 
 RADIUS = 0.25
 COVERAGE = 0.06
@@ -82,10 +83,14 @@ def realistic_fleet(k, n, seed):
 
 
 def condition_fleet(k, n, seed):
-    """Return a Fleet that meets the theorem's condition exactly (lattice of pitch 4R)."""
+    """Return a Fleet that meets the theorem's condition exactly (lattice of pitch S)."""
     rng = np.random.default_rng(seed)
     side = int(np.ceil(np.sqrt(1.5 * k + 10)))
-    cells = np.array([(c, r) for c in range(side) for r in range(side)], float) * 4 * RADIUS
+    # S for the widest pillar drawn below (rho = R): 2R + nu + w (doc/design.md section 6).
+    widest = Workspace([[0.0, 0.0]], variant='discs', robot_radius=RADIUS,
+                       obstacle_radius=RADIUS).disc_layout.reach.max()
+    pitch = max(4 * RADIUS, (2 + MARGIN) * RADIUS + widest)
+    cells = np.array([(c, r) for c in range(side) for r in range(side)], float) * pitch
     for _ in range(100):
         pick = rng.permutation(len(cells))
         pillars = cells[pick[:int(rng.integers(3, 11))]]
@@ -141,7 +146,7 @@ def run_ours(fleet, variant, repeats=3):
     best = build = np.inf
     for _ in range(repeats):
         begin = time.perf_counter()
-        result = plan(workspace, fleet.configurations, certify=False)
+        result = plan(workspace, fleet.configurations, certify=False, refine=False)
         built = time.perf_counter()
         gap = result.min_gap
         best = min(best, time.perf_counter() - begin)
@@ -172,13 +177,13 @@ def continuity(fleet, rng, trials=3):
     """Return the largest motion change / input change over small moves inside a domain."""
     workspace = Workspace(fleet.pillars, variant='discs', robot_radius=RADIUS,
                           obstacle_radius=fleet.radii)
-    base = plan(workspace, fleet.configurations, certify=False)
+    base = plan(workspace, fleet.configurations, certify=False, refine=False)
     tau = np.linspace(0.0, 1.0, 4001)
     worst = 0.0
     for _ in range(trials):
         moved = fleet.configurations + rng.uniform(-PERTURBATION, PERTURBATION,
                                                    fleet.configurations.shape)
-        other = plan(workspace, moved, certify=False)
+        other = plan(workspace, moved, certify=False, refine=False)
         if not np.array_equal(other.projection_counts, base.projection_counts):
             continue
         change = np.abs(other.position(tau) - base.position(tau)).max()

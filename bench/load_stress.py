@@ -12,7 +12,7 @@ a retry cannot hide here.
 
 Prints per round and in total: calls, lost calls (no answer within 20 s),
 calls answered with an error code, and the node's "not sent" errors (replies
-rmw could not send, doc/design.md section 14). Printed, not asserted.
+rmw could not send, doc/design.md section 15). Printed, not asserted.
 
     .venv/bin/python bench/load_stress.py                     # 20 x 4 x 250, 2 hogs
     .venv/bin/python bench/load_stress.py --rounds 3 --hogs 0

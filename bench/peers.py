@@ -12,6 +12,7 @@ Run alone: ``.venv/bin/python bench/peers.py [--quick]``.
 
 import argparse
 from dataclasses import dataclass, field
+from functools import partial
 import itertools
 import os
 import sys
@@ -20,8 +21,11 @@ import time
 from core_speed import format_table, median_time, random_obstacles
 import numpy as np
 
-from punctured_planner.core import plan, Workspace
+from punctured_planner.core import plan as core_plan, Workspace
 from punctured_planner.core.certificate import certify
+
+# The construction's figures (the refinement's are bench/refinement.py's).
+plan = partial(core_plan, refine=False)
 
 RADIUS = 0.05
 SEPARATION = 2 * RADIUS

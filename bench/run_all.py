@@ -20,6 +20,7 @@ from core_speed import format_table
 import discs
 import numpy as np
 import peers
+import refinement
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 RESULTS_MD = os.path.join(HERE, 'results.md')
@@ -123,7 +124,8 @@ def service_sweep(quick):
     return result.stdout.strip() or 'failed:\n' + result.stderr.strip()[-2000:]
 
 
-def write_markdown(figures, outcomes, settings, seconds, stages, profiles, service, disc_lines):
+def write_markdown(figures, outcomes, settings, seconds, stages, profiles, service, disc_lines,
+                   refinement_lines):
     """Write bench/results.md."""
     by = {
         'k': lambda q: q.k, 'kind': lambda q: q.kind, 'd': lambda q: q.d,
@@ -160,6 +162,8 @@ def write_markdown(figures, outcomes, settings, seconds, stages, profiles, servi
         parts += [f'cProfile, {name}:', '', '```', text, '```', '']
     parts += ['## Disc robots among pillars', '', discs.__doc__.strip().split('\n\n')[1], '',
               *disc_lines, '']
+    parts += ['## The refinement (issue 18)', '',
+              refinement.__doc__.strip().split('\n\n')[1], '', *refinement_lines, '']
     parts += ['## Service round trip over DDS against k', '',
               'planner_node in its own process, one client, Fast DDS on this machine '
               '(`bench/service_roundtrip.py --sweep`); most of the time at large k is '
@@ -235,11 +239,14 @@ def main(argv=None):
     outcomes = peers.run(settings, progress)
     print('==> disc robots among pillars', file=sys.stderr, flush=True)
     disc_lines = discs.report(discs.quick_settings() if args.quick else discs.Settings())
+    print('==> the refinement against the construction and OMPL', file=sys.stderr, flush=True)
+    refinement_lines = refinement.report(refinement.quick_settings() if args.quick
+                                         else refinement.Settings())
     print('==> service round trip over DDS', file=sys.stderr, flush=True)
     service = service_sweep(args.quick)
     seconds = time.perf_counter() - start
     write_markdown(figures, outcomes, settings, seconds, stages, profiles, service,
-                   disc_lines)
+                   disc_lines, refinement_lines)
     write_plot(figures, outcomes)
     print('\n'.join(headline(figures, outcomes)))
     print()
@@ -250,6 +257,8 @@ def main(argv=None):
     print(format_table([('figure', 'value', 'target')] + core_speed.summary_rows(figures)))
     print()
     print('\n'.join(disc_lines))
+    print()
+    print('\n'.join(refinement_lines))
     print()
     print(service)
     print(f'\nwrote {RESULTS_MD} and {RESULTS_PNG} in {seconds / 60:.1f} min')

@@ -9,10 +9,14 @@ straight segments through C_1..C_n). Run: ``.venv/bin/python bench/spread_cleara
 """
 
 import argparse
+from functools import partial
 
 import numpy as np
 
-from punctured_planner.core import plan, Workspace
+from punctured_planner.core import plan as core_plan, Workspace
+
+# The construction's figures (the refinement's are bench/refinement.py's).
+plan = partial(core_plan, refine=False)
 
 SEPARATION = 0.5
 

@@ -35,7 +35,7 @@ def _gif_path(text):
 
 
 def add_render_arguments(parser):
-    """Add --png, --dpi, --gif, --gif-fps, --gif-seconds and --gif-dpi to an argparse parser."""
+    """Add --png, --dpi, --raw, --gif, --gif-fps, --gif-seconds and --gif-dpi to a parser."""
     group = parser.add_argument_group('pictures')
     group.add_argument('--png', metavar='OUT.png',
                        help='draw the plan (paths, lanes, waypoints, domain, clearance)')
@@ -49,6 +49,8 @@ def add_render_arguments(parser):
                        help='resolution of the animation (default: %(default)s)')
     group.add_argument('--dpi', type=_positive_float, default=100.0,
                        help='resolution of the PNG picture (default: %(default)s)')
+    group.add_argument('--raw', action='store_true',
+                       help="overlay the construction's unrefined motion, dashed, on the PNG")
     return group
 
 
@@ -56,7 +58,8 @@ def render_outputs(args, plan, title=None, max_speed=1.0):
     """Write the pictures asked for by add_render_arguments' options; return their paths."""
     written = []
     if getattr(args, 'png', None):
-        written.append(render_png(plan, args.png, title=title, dpi=args.dpi))
+        written.append(render_png(plan, args.png, title=title, dpi=args.dpi,
+                                  raw=getattr(args, 'raw', False)))
     if getattr(args, 'gif', None):
         written.append(render_animation(plan, args.gif, fps=args.gif_fps,
                                         seconds=args.gif_seconds, dpi=args.gif_dpi,

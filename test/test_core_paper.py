@@ -1,6 +1,7 @@
 """The paper variant reproduces the paper's construction exactly (doc/design.md section 3)."""
 
 from fractions import Fraction
+from functools import partial
 
 import numpy as np
 from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
@@ -8,13 +9,17 @@ from punctured_planner.core.complexity import sequential_complexity
 from punctured_planner.core.sections import PAPER_FRACTIONS
 import pytest
 
+# These tests check the construction itself (doc/design.md sections 3, 5), not its
+# refinement (section 14).
+base = partial(plan, refine=False)
+
 WORKED_OBSTACLES = [[0.0, 0.0], [1.0, 0.0]]
 WORKED_REQUEST = [[[0.5, 1.0], [0.5, -2.0]], [[3.0, 0.5], [-1.0, 2.0]]]
 
 
 def test_worked_example_breakpoints_exactly():
     """The worked example of doc/design.md section 10, breakpoint by breakpoint."""
-    p = plan(Workspace(WORKED_OBSTACLES), WORKED_REQUEST)
+    p = base(Workspace(WORKED_OBSTACLES), WORKED_REQUEST)
     expected = np.array([
         [[0.5, 1], [0.5, -2]], [[0.75, 1], [0.875, -2]], [[0.75, 0], [0.875, 0]],
         [[0.75, 3], [0.875, 4]], [[3, 3], [-1, 4]], [[3, 0], [-1, 0]],
@@ -36,7 +41,7 @@ def test_figure_two_desingularisation_and_obstacle_shared_projection():
     first = [[2.5, 2.0], [0.0, 3.0], [2.5, -3.0]]
     second = [[4.5, 1.0], [-1.0, 1.0], [1.5, 2.0]]
     third = [[0.5, -1.0], [2.5, 1.0], [3.5, 0.5]]
-    p = plan(Workspace(obstacles), [first, second, third])
+    p = base(Workspace(obstacles), [first, second, third])
     # cp: {0,1,2,3,4,2.5} = 6 -> D runs; eps = 0.5 / 8; paper indices 6, 7, 8.
     assert p.projection_counts.tolist() == [6, 8, 8]
     eps = 0.5 / 8
@@ -56,7 +61,7 @@ def test_figure_two_desingularisation_and_obstacle_shared_projection():
 
 def test_robot_sharing_projection_with_obstacle_moves_off_it():
     """A robot straight above an obstacle is shifted by r eps before projecting."""
-    p = plan(Workspace([[0.0, 0.0], [2.0, 0.0]]), [[[2.0, 1.0]], [[5.0, 1.0]]])
+    p = base(Workspace([[0.0, 0.0], [2.0, 0.0]]), [[[2.0, 1.0]], [[5.0, 1.0]]])
     assert p.projection_counts.tolist() == [2, 3]
     eps = 2.0 / 3
     assert np.array_equal(p.positions[1], [[2.0 + 2 * eps, 1.0]])
@@ -65,11 +70,11 @@ def test_robot_sharing_projection_with_obstacle_moves_off_it():
 
 def test_without_obstacles_and_with_one():
     """Without obstacles and with one: their own domain ranges and lanes."""
-    free = plan(Workspace([], dimension=3), np.random.default_rng(1).normal(size=(3, 4, 3)))
+    free = base(Workspace([], dimension=3), np.random.default_rng(1).normal(size=(3, 4, 3)))
     assert free.domain_range == (3, 12) and free.domain_count == 10
     assert free.sequential_complexity == 10 and free.optimal
     assert free.lanes.tolist() == [1.0, 2.0, 3.0, 4.0]
-    single = plan(Workspace([[0.0, 0.0]]), [[[0.0, 1.0], [0.0, 2.0]], [[1.0, 1.0], [2.0, 2.0]]])
+    single = base(Workspace([[0.0, 0.0]]), [[[0.0, 1.0], [0.0, 2.0]], [[1.0, 1.0], [2.0, 2.0]]])
     assert single.projection_counts.tolist() == [1, 3]
     assert single.domain_range == (2, 6) and single.sequential_complexity == 4
     assert not single.optimal and single.min_clearance > 0
@@ -94,7 +99,7 @@ def test_optimal_exactly_where_the_count_meets_the_theorem():
     for r in (0, 1, 2, 3):
         for d in (2, 3):
             obstacles = np.c_[np.arange(r, dtype=float), np.zeros((r, d - 1))]
-            p = plan(Workspace(obstacles, dimension=d), rng.normal(size=(2, 3, d)) + 0.5)
+            p = base(Workspace(obstacles, dimension=d), rng.normal(size=(2, 3, d)) + 0.5)
             assert p.optimal == (r >= 2 or d % 2 == 1)
             assert p.domain_count - p.sequential_complexity == (0 if p.optimal else 1)
 
@@ -108,7 +113,7 @@ def test_frame_falls_back_when_axes_do_not_separate_obstacles():
     assert np.array_equal(diagonal.frame.e1, again.frame.e1)
     assert np.unique(diagonal.obstacle_projections).size == 3
     assert abs(diagonal.frame.e1 @ diagonal.frame.e2) < 1e-12
-    p = plan(diagonal, [[[0.5, 0.5], [2.0, 2.0]], [[-1.0, 3.0], [0.2, 0.1]]])
+    p = base(diagonal, [[[0.5, 0.5], [2.0, 2.0]], [[-1.0, 3.0], [0.2, 0.1]]])
     assert p.min_clearance > 0
     lane_base = diagonal.frame.offset(diagonal.obstacles).max()
     assert np.all(p.lanes > lane_base)
@@ -129,7 +134,7 @@ def test_caller_frame_is_used():
     """A rotated frame: projections and lanes follow it."""
     c, s = np.cos(0.3), np.sin(0.3)
     ws = Workspace([[0.0, 0.0], [1.0, 0.0]], frame=([0, 0], [c, s], [-s, c]))
-    p = plan(ws, [[[0.3, 2.0]], [[2.0, -1.0]]])
+    p = base(ws, [[[0.3, 2.0]], [[2.0, -1.0]]])
     axis_point = p.positions[2, 0]
     assert abs(axis_point @ np.array([-s, c])) < 1e-12
     # The lane runs along the rotated e1, at its height along the rotated e2.
@@ -153,7 +158,7 @@ def test_caller_frame_is_used():
 def test_bad_requests_name_the_culprit(request_, code, words):
     """Each validation error has its code and names configuration, robots, obstacle."""
     with pytest.raises(PlanningError) as error:
-        plan(Workspace(WORKED_OBSTACLES), request_)
+        base(Workspace(WORKED_OBSTACLES), request_)
     assert error.value.code == code
     assert words in str(error.value)
 
@@ -168,7 +173,7 @@ def test_coincident_obstacles_are_refused():
 
 def test_position_interpolates_and_hits_breakpoints():
     """position(tau) is linear between breakpoints, vectorised over many tau."""
-    p = plan(Workspace(WORKED_OBSTACLES), WORKED_REQUEST)
+    p = base(Workspace(WORKED_OBSTACLES), WORKED_REQUEST)
     assert np.array_equal(p.position(p.times), p.positions)
     middle = (p.times[3] + p.times[4]) / 2
     assert np.allclose(p.position(middle), (p.positions[3] + p.positions[4]) / 2)

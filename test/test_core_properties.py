@@ -1,4 +1,6 @@
-"""Properties of the core over random and degenerate inputs (hypothesis)."""
+"""Properties of the construction over random and degenerate inputs (hypothesis)."""
+
+from functools import partial
 
 from core_inputs import axis_obstacles, configuration_with_count
 from core_strategies import requests
@@ -11,6 +13,8 @@ import pytest
 PROPERTY = settings(max_examples=150, deadline=None,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
 VARIANTS = st.sampled_from(['paper', 'spread'])
+# The construction's own motion; the refinement's properties are test_core_refine.py's.
+base = partial(plan, refine=False)
 
 
 def dense_minimum(p, samples_per_leg=40):
@@ -33,7 +37,7 @@ def dense_minimum(p, samples_per_leg=40):
 def test_waypoints_are_the_input_bit_for_bit(request, variant):
     """The motion passes through every configuration at its waypoint, exactly."""
     obstacles, configurations, _ = request
-    p = plan(Workspace(obstacles, dimension=obstacles.shape[1], variant=variant), configurations)
+    p = base(Workspace(obstacles, dimension=obstacles.shape[1], variant=variant), configurations)
     n = len(configurations)
     assert np.array_equal(p.positions[p.waypoint_indices], configurations)
     tau = np.arange(n) / (n - 1)
@@ -47,7 +51,7 @@ def test_waypoints_are_the_input_bit_for_bit(request, variant):
 def test_certified_clearance_is_positive_and_agrees_with_dense_check(request, variant):
     """Certificate > 0, never above a dense sample, and reached where it says."""
     obstacles, configurations, _ = request
-    p = plan(Workspace(obstacles, dimension=obstacles.shape[1], variant=variant), configurations)
+    p = base(Workspace(obstacles, dimension=obstacles.shape[1], variant=variant), configurations)
     clearance = p.clearance
     if clearance.kind == 'none':
         assert len(obstacles) == 0 and configurations.shape[1] == 1
@@ -66,7 +70,7 @@ def test_domain_is_the_sum_of_projection_counts(request, variant):
     """The domain l = cp(C_1) + ... + cp(C_n), inside its range; index and count follow."""
     obstacles, configurations, mode = request
     ws = Workspace(obstacles, dimension=obstacles.shape[1], variant=variant)
-    p = plan(ws, configurations)
+    p = base(ws, configurations)
     n, k, _ = configurations.shape
     r = len(obstacles)
     projections = ws.frame.project(configurations)
@@ -85,9 +89,9 @@ def test_domain_is_the_sum_of_projection_counts(request, variant):
 def test_determinism_bit_for_bit(request, variant):
     """The same input gives the same plan, even through a fresh workspace."""
     obstacles, configurations, _ = request
-    first = plan(Workspace(obstacles, dimension=obstacles.shape[1], variant=variant),
+    first = base(Workspace(obstacles, dimension=obstacles.shape[1], variant=variant),
                  configurations)
-    second = plan(Workspace(obstacles.copy(), dimension=obstacles.shape[1], variant=variant),
+    second = base(Workspace(obstacles.copy(), dimension=obstacles.shape[1], variant=variant),
                   configurations.copy())
     assert np.array_equal(first.times, second.times)
     assert np.array_equal(first.positions, second.positions)
@@ -125,7 +129,7 @@ def test_continuity_inside_a_domain(request, variant, seed):
     size = 1e-7
     perturbed = perturb_within_domain(np.random.default_rng(seed), configurations, obstacles,
                                       size)
-    before, after = plan(ws, configurations), plan(ws, perturbed)
+    before, after = base(ws, configurations), base(ws, perturbed)
     assert before.projection_counts.tolist() == after.projection_counts.tolist()
     moved = np.linalg.norm(perturbed - configurations, axis=2).max()
     change = np.linalg.norm(after.positions - before.positions, axis=2).max()
@@ -144,7 +148,7 @@ def test_every_domain_value_is_hit(r, k, n, d):
     for _ in range(60 * (high - low + 1)):
         targets = rng.integers(max(r, 1), k + r + 1, size=n)
         request = [configuration_with_count(rng, obstacles, k, t) for t in targets]
-        p = plan(ws, request)
+        p = base(ws, request)
         assert p.projection_counts.tolist() == targets.tolist()
         hit.add(p.domain)
     assert hit == set(range(low, high + 1))

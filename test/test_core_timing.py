@@ -9,7 +9,7 @@ REQUEST = [[[0.5, 1.0], [0.5, -2.0]], [[3.0, 0.5], [-1.0, 2.0]]]
 
 def test_each_leg_takes_its_fastest_robot_at_max_speed():
     """Leg durations are the largest displacement over max_speed."""
-    p = plan(Workspace([[0.0, 0.0], [1.0, 0.0]]), REQUEST)
+    p = plan(Workspace([[0.0, 0.0], [1.0, 0.0]]), REQUEST, refine=False)
     stamps = p.stamps(2.0)
     steps = np.linalg.norm(np.diff(p.positions, axis=0), axis=2).max(axis=1)
     assert np.allclose(np.diff(stamps), steps / 2.0)
@@ -20,7 +20,7 @@ def test_each_leg_takes_its_fastest_robot_at_max_speed():
 
 def test_resampling_keeps_every_breakpoint_bit_for_bit():
     """Extra samples land inside legs; breakpoints and their stamps are unchanged."""
-    p = plan(Workspace([[0.0, 0.0], [1.0, 0.0]]), REQUEST)
+    p = plan(Workspace([[0.0, 0.0], [1.0, 0.0]]), REQUEST, refine=False)
     samples = p.sample(3, max_speed=1.5)
     # The last leg (D^-1 of C_2, in the top stratum) is the only one where nothing moves.
     assert samples.positions.shape[0] == 4 * (p.times.size - 2) + 1
@@ -34,7 +34,7 @@ def test_resampling_keeps_every_breakpoint_bit_for_bit():
 @pytest.mark.parametrize('samples_per_leg', [0, 2])
 @pytest.mark.parametrize('variant', ['paper', 'spread'])
 def test_no_pose_twice_and_every_configuration_exact(samples_per_leg, variant):
-    """Stamps strictly increase (no 0/0 speed); C_m sits exactly at waypoints[m]."""
+    """Stamps strictly increase (no 0/0 speed); C_m sits exactly at waypoints[m] (refined)."""
     obstacles = [[-2.0, 0.5], [0.0, -0.5], [2.5, 0.0]]
     request = np.array([[[-3.0, -2.0], [-1.0, -2.5], [1.0, -2.0], [3.0, -2.5]],
                         [[-2.0, -1.5], [0.0, 1.5], [1.5, -1.5], [3.5, 1.0]],

@@ -8,7 +8,7 @@ from punctured_planner.ros.settings import FLEET_SIM
 from punctured_planner.ros.settings import PLANNER
 import pytest
 
-KINDS = {'string': 'string', 'integer': 'integer', 'double': 'double',
+KINDS = {'string': 'string', 'bool': 'bool', 'integer': 'integer', 'double': 'double',
          'string_array': 'string array', 'double_array': 'double array'}
 
 

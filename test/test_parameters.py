@@ -27,6 +27,7 @@ def test_values_take_the_parameter_kinds():
     ({'frame_id': ''}, 'frame_id'), ({'lane_spacing': 0.0}, 'lane_spacing'),
     ({'max_speed': True}, 'max_speed'), ({'dimension': 2.0}, 'integer'),
     ({'nonsense': 1}, 'unknown'), ({'robot_count': 5, 'max_robots': 4}, 'max_robots'),
+    ({'refine': 1}, 'refine must be true or false'),
 ])
 def test_settings_validation_gives_reasons(values, words):
     with pytest.raises(ValueError, match=words):

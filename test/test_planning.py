@@ -66,6 +66,26 @@ def test_discs_answers_over_max_poses_are_refused_once_planned():
     assert PlanSequenceHandler().handle(make_request(), PlanSequence.Response(), enough, 0).ok
 
 
+def test_refined_answers_are_checked_by_their_own_pose_count():
+    """The refinement adds knots: max_poses is checked against the refined plan's poses."""
+    from punctured_planner_interfaces.srv import PlanSequence
+    flat = [v for o in OBSTACLES for v in o]
+    raw = PlanSequenceHandler().handle(make_request(), PlanSequence.Response(),
+                                       snapshot(obstacles=flat, refine=False), 0)
+    refined = PlanSequenceHandler().handle(make_request(), PlanSequence.Response(),
+                                           snapshot(obstacles=flat), 0)
+    assert raw.ok and refined.ok and raw.plan.raw is None and refined.plan.raw is not None
+    poses = 4 * len(refined.plan.times)
+    assert 4 * len(raw.plan.times) < poses
+    # Enough for the construction's breakpoints, not for the refined plan's.
+    limited = snapshot(obstacles=flat, max_poses=poses - 1)
+    outcome = PlanSequenceHandler().handle(make_request(), PlanSequence.Response(), limited, 0)
+    assert outcome.response.error_code == PlanSequence.Response.REQUEST_OVER_LIMITS
+    assert 'more than max_poses %d' % (poses - 1) in outcome.response.error_msg
+    enough = snapshot(obstacles=flat, max_poses=poses)
+    assert PlanSequenceHandler().handle(make_request(), PlanSequence.Response(), enough, 0).ok
+
+
 def test_array_holding_dataclasses_compare_by_identity():
     """Frame, ObstacleSet, RobotState, PlaneView: == and hash work (no numpy ValueError)."""
     from punctured_planner.core import Workspace

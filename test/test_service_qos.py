@@ -3,7 +3,7 @@ No reply or request of ``plan_sequence`` is dropped by a DDS history (issue 21).
 
 rmw_fastrtps delivers every reply of a service to every client of it; each
 client's reader keeps the replies it has not taken in a KEEP_LAST history
-(doc/design.md section 14). These tests stall one side for longer than
+(doc/design.md section 15). These tests stall one side for longer than
 rclpy's default depth of 10 and check that nothing is lost with the QoS of
 :mod:`punctured_planner.ros.qos`; the default QoS beside it loses the reply,
 which is the cause of the lost call of issue 21.
@@ -83,7 +83,7 @@ def test_a_stalled_client_keeps_its_reply_while_others_are_answered(
     assert got['service_qos'], 'the stalled client lost its reply:\n' + node.log()
     assert futures['service_qos'].result().error_code == PlanSequence.Response.NONE
     # The cause of issue 21, pinned: with rclpy's default depth the reply is dropped.
-    assert not got['rclpy_default'], 'depth 10 kept its reply: doc/design.md section 14'
+    assert not got['rclpy_default'], 'depth 10 kept its reply: doc/design.md section 15'
 
 
 def test_requests_waiting_while_the_node_is_stopped_are_all_answered(

@@ -1,7 +1,7 @@
 """
 ROS-free math core: the sequential planner of Ipanaque Zapata & González, numpy only.
 
-One module per idea of the paper: ``space`` (the space and its frame),
+One module per idea of the paper: ``space`` (the space), ``frame`` (its frame),
 ``strata`` (cp and eps), ``deformations`` (D, S, phi), ``sections`` (Gamma,
 lanes, the composition of Remark 2.3 and the variant table), ``plan`` (the
 plan as breakpoints), ``certificate`` (exact clearance), ``timing`` (time
@@ -12,9 +12,10 @@ is doc/design.md.
 
 from .certificate import Clearance
 from .errors import ErrorCode, PlanningError
+from .frame import Frame
 from .plan import Plan, plan, Samples
 from .sections import Schedule, SCHEDULES, VARIANTS
-from .space import Frame, Workspace
+from .space import Workspace
 from .validation import first_out_of_range, MAX_COORDINATE
 
 __all__ = ['Clearance', 'ErrorCode', 'first_out_of_range', 'Frame', 'MAX_COORDINATE', 'Plan',

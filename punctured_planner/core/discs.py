@@ -5,9 +5,10 @@ Robots are discs (balls for d >= 3) of radius R, obstacle j a pillar of radius
 rho_j; the surface gap of two robots is |x_a - x_b| - 2R, of a robot and a
 pillar |x - q_j| - R - rho_j. Write p(x) for the e1 projection, h(x) for the e2
 offset and w_j = R + rho_j + mu_j for the reach of pillar j, where the passing
-margin mu_j = clip(R - rho_j, 0, R / 10) keeps robots off the pillars
-they pass without w_j exceeding 2R when rho_j <= R (w_j = min_spacing / 2 when
-both radii are 0, so point robots still keep off point obstacles).
+margin mu_j = max(R, rho_j) / 10 keeps robots off every pillar they pass, as
+wide as it may be (w_j = min_spacing / 2 when both radii are 0, so point
+robots still keep off point obstacles), and nu = R / 10 is the margin kept
+between two robots.
 
 A required gap c (required_clearance) is planned for by inflating R and every
 rho_j by c / 2 (Workspace.disc_layout): a gap >= 0 between the inflated bodies
@@ -34,11 +35,12 @@ The construction keeps the paper's skeleton, H(C_m), Gamma, H(C_{m+1})^-1
 * gather (CAPT's synchronised straight lines, Turpin, Michael & Kumar): every
   robot moves on a straight line to slot rank(x) of the staging line at height
   top (the axis itself when there are no pillars) centred on the mean robot
-  projection, slots g = max(min_spacing, 4R / sqrt 3) apart along e1; rank
+  projection, slots g = max(min_spacing, g_R) apart along e1, g_R = 2aS / sqrt(S^2 - 4a^2)
+  for a = R + nu / 2 and S = 4R (about 2.47R, where 4R / sqrt 3 would keep 2R only); rank
   orders robots by projection, ties by index.
 * Gamma between staging lines (the paper's section, equation 3.1, with shared
   lanes): every robot lifts to its lane top + (l + 1) c, c = max(lane_spacing,
-  2R), slides to its next slot and drops. Robots whose slots keep their order
+  2R + nu), slides to its next slot and drops. Robots whose slots keep their order
   share a lane (shared_lanes), so a segment needs as many lanes as its longest
   run of robots whose order reverses, not k.
 
@@ -51,45 +53,54 @@ paper, whose projection counts, domains and TC_n it shares. Breakpoints that
 appear as a robot enters a shadow carry a push of size 0 and split legs along
 which every robot moves linearly, so they do not change the motion.
 
-Theorem (bodies never touch). Let S = max(4R, 2R + max_j w_j), which is 4R
-when every rho_j <= R. Suppose in every configuration (a) robot centres are at
-least S apart, (b) no robot disc overlaps a pillar (|x - q_j| >= R + rho_j;
-validation refuses the rest), and (c) any two pillars j, l satisfy
-|p(q_j) - p(q_l)| >= w_j + w_l + 2R or |h(q_j) - h(q_l)| >= z_j + z_l + 2R.
-Then min_gap >= 0 (up to the rounding of the coordinates).
+Theorem (bodies keep a margin). Let S = max(4R, 2R + nu + max_j w_j), which
+is 4R when every rho_j <= 0.8R. Suppose in every configuration (a) robot
+centres are at least S apart, (b) no robot disc overlaps a pillar
+(|x - q_j| >= R + rho_j; validation refuses the rest), and (c) any two pillars
+j, l satisfy |p(q_j) - p(q_l)| >= w_j + w_l + 2R + nu or
+|h(q_j) - h(q_l)| >= z_j + z_l + 2R + nu. Then every gap of a robot and pillar
+j stays >= min(mu_j, its gap in the configurations) and every gap of two
+robots >= nu: min_gap >= min(nu, g_C) with nu = R / 10, g_C the smallest
+robot-pillar gap of the configurations themselves (a robot touching a pillar
+in C_m keeps that gap there), a margin far above the rounding of the
+coordinates unless the input itself touches.
 
 Proof. Every leg is one of the following.
 (1) Sidestep and rise, robot and pillar j. While |u| > w_j the e2 distance
 exceeds w_j. While |u| <= w_j, the push of j alone puts the robot at e1
 offset delta + lambda_j (w_j - delta) >= lambda_j w_j >= sqrt(w_j^2 - u^2)
-from p(q_j), so at distance >= w_j. Pushes of pillars on the same side only
-add to it. A pillar l on the other side pushes only while the robot is in its
-shadow and |u_l| < z_l, which puts l within w_j + w_l of p(q_j) in e1 and
-within w_j + z_l of h(q_j) in e2, excluded by (c). A robot pushed towards a
-pillar l whose shadow it was not in reaches it only if |p(q_j) - p(q_l)| <
-w_j + w_l, and then by (c) it is more than z_l + 2R from h(q_l) in e2.
+from p(q_j), so at distance >= w_j (gap >= mu_j); the sidestep moves a robot
+straight away from p(q_j), so its gap only grows from C's. Pushes of pillars on the
+same side only add to it. A pillar l on the other side pushes only while the
+robot is in its shadow and |u_l| < z_l, which puts l within w_j + w_l of
+p(q_j) in e1 and within w_j + z_l of h(q_j) in e2, excluded by (c). A robot
+pushed towards a pillar l whose shadow it was not in reaches it only if
+|p(q_j) - p(q_l)| < w_j + w_l, and then by (c) it is more than z_l + 2R + nu
+from h(q_l) in e2.
 (2) Sidestep and rise, two robots. Their e2 and other coordinates change by
-the same s, so if those differ by at least 2R the robots never touch.
-Otherwise their e1 distance is at least sqrt(S^2 - 4R^2) > max w_j, so they
-are not in one shadow on one side, and by (c) no robot is pushed by two
-pillars at once (their shadows and zones would overlap). If both are pushed
-towards each other, by j and l, their zones overlap within 2R in e2, so by (c)
-p(q_l) - p(q_j) >= w_j + w_l + 2R while they stay within w_j of p(q_j) and w_l
-of p(q_l): 2R apart in e1. Otherwise at most one moves towards the other, by
-at most w_max <= S - 2R in e1, and (|dp| - w_max)^2 + dh^2 >= 4R^2 whenever
-|dp|^2 + dh^2 >= S^2.
+the same s, so if those differ by at least 2R + nu the gap stays >= nu.
+Otherwise their e1 distance is at least sqrt(S^2 - (2R + nu)^2) > max w_j,
+so they are not in one shadow on one side, and by (c) no robot is pushed by
+two pillars at once (their shadows and zones would overlap). If both are
+pushed towards each other, by j and l, their zones overlap within 2R + nu in
+e2, so by (c) p(q_l) - p(q_j) >= w_j + w_l + 2R + nu while they stay within
+w_j of p(q_j) and w_l of p(q_l): 2R + nu apart in e1. Otherwise at most one
+moves towards the other, by at most w_max = max_j w_j in e1, and
+(|dp| - w_max)^2 + dh^2 = S^2 - 2 w_max sqrt(S^2 - dh^2) + w_max^2 grows with
+dh, so it is at least (S - w_max)^2 >= (2R + nu)^2 whenever |dp|^2 + dh^2 >= S^2.
 (3) Gather. It starts from C + T e2 (pairwise >= S) and ends on slots >= g
 apart along e1 in projection order. For robots a, b with rank a < rank b the
 start difference P = x_b - x_a has P.e1 >= 0 and the end difference Q is a
 positive multiple of e1, so P.Q >= 0 and |(1 - t) P + t Q|^2 >=
-(1 - t)^2 S^2 + t^2 g^2 >= S^2 g^2 / (S^2 + g^2) >= 4R^2 for
-g >= 2RS / sqrt(S^2 - 4R^2), which g >= 4R / sqrt 3 satisfies for S >= 4R.
-The start, the slots and so the straight lines lie in the half-space h >= top,
-where every robot is at least z_j >= w_j from every pillar.
-(4) Gamma. Lifts and drops are along e2 in columns g >= 2R apart, slides along
-e1 in lanes c >= 2R apart, all in h >= top; two robots in one lane keep their
-order and slide linearly between slots g apart, so they stay g >= 2R apart.
-The inverse legs are the same legs run backwards. QED.
+(1 - t)^2 S^2 + t^2 g^2 >= S^2 g^2 / (S^2 + g^2) >= (2R + nu)^2 for
+g >= 2aS / sqrt(S^2 - 4a^2), a = R + nu / 2, a bound that decreases in S, so
+g_R (taken at S = 4R) serves every S >= 4R. The start, the slots and so the
+straight lines lie in the half-space h >= top, where every robot is at least
+z_j >= w_j from every pillar.
+(4) Gamma. Lifts and drops are along e2 in columns g >= 2R + nu apart, slides
+along e1 in lanes c >= 2R + nu apart, all in h >= top; two robots in one lane
+keep their order and slide linearly between slots g apart, so they stay g
+apart. The inverse legs are the same legs run backwards. QED.
 
 Outside the condition the plan is made all the same; the exact certificate
 (Plan.min_gap) says what it achieved and required_clearance refuses it.
@@ -97,12 +108,10 @@ Outside the condition the plan is made all the same; the exact certificate
 
 from bisect import bisect_left
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-if TYPE_CHECKING:  # space imports this module: the Frame type only, for annotations
-    from .space import Frame
+from .frame import Frame
 
 # The push zone of pillar j in relative height u: full push for |u| <= FULL w_j,
 # none beyond ZONE w_j, linear between. The push to w_j lambda_j(u) then traces
@@ -110,10 +119,12 @@ if TYPE_CHECKING:  # space imports this module: the Frame type only, for annotat
 # 0 and 45 degrees meet at u = (sqrt 2 - 1) w_j, the 45 degree one reaches the
 # axis at u = sqrt 2 w_j.
 FULL, ZONE = np.sqrt(2.0) - 1.0, np.sqrt(2.0)
-# Passing margin mu_j, at most this fraction of R (see DiscLayout.from_radii).
-PASSING_MARGIN = 0.1
-# Slot spacing for robots S = 4R apart: 4R / sqrt(3) keeps the gather at 2R.
-_SLOT_FACTOR = 4.0 / np.sqrt(3.0)
+# The body margins as fractions: mu_j = MARGIN max(R, rho_j) past pillar j, nu = MARGIN R
+# between two robots (module docstring). Every body gap of the plan keeps one of them.
+MARGIN = 0.1
+# Slot spacing g / R for robots S >= 4R apart: the gather then keeps pairs 2R + nu apart
+# (g = 2 a S / sqrt(S^2 - 4 a^2) with a = R + nu / 2 and S = 4R; 4 / sqrt 3 keeps only 2R).
+_SLOT_FACTOR = 8.0 * (1.0 + MARGIN / 2) / np.sqrt(16.0 - 4.0 * (1.0 + MARGIN / 2) ** 2)
 
 SIDESTEP, RISE, GATHER = 'sidestep', 'rise', 'gather'
 LIFT, SLIDE, DROP = 'lift', 'slide', 'drop'
@@ -129,7 +140,7 @@ class DiscLayout:
     pitch c (module docstring).
     """
 
-    frame: 'Frame'
+    frame: Frame
     pillar_projections: np.ndarray
     pillar_offsets: np.ndarray
     reach: np.ndarray
@@ -140,14 +151,14 @@ class DiscLayout:
     lane_pitch: float
 
     @classmethod
-    def from_radii(cls, frame: 'Frame', obstacles: np.ndarray, robot_radius: float,
+    def from_radii(cls, frame: Frame, obstacles: np.ndarray, robot_radius: float,
                    obstacle_radius: np.ndarray, lane_spacing: float,
                    min_spacing: float) -> 'DiscLayout':
         """Return the layout for pillars (r, d) of radii (r,) and robots of radius R."""
-        # A margin mu_j = clip(R - rho_j, 0, R / 10) keeps robots off the pillars they
-        # pass without making w_j exceed 2R, so S stays 4R for rho_j <= R; a wider one
-        # makes neighbouring pillars' zones overlap more often (measured in bench/).
-        margin = np.clip(robot_radius - obstacle_radius, 0.0, PASSING_MARGIN * robot_radius)
+        # A passing margin for every pillar size: mu_j = 0 (rho_j >= R, before) let bodies
+        # graze. S stays 4R while w_j <= 1.9R (rho_j <= 0.8R); wider margins make
+        # neighbouring pillars' zones overlap more often (measured in bench/).
+        margin = MARGIN * np.maximum(robot_radius, obstacle_radius)
         reach = robot_radius + obstacle_radius + margin
         reach = np.where(reach > 0, reach, 0.5 * min_spacing)
         offsets = frame.offset(obstacles)
@@ -155,20 +166,21 @@ class DiscLayout:
         return cls(frame, frame.project(obstacles), offsets, reach, FULL * reach, ZONE * reach,
                    top,
                    max(min_spacing, _SLOT_FACTOR * robot_radius),
-                   max(lane_spacing, 2.0 * robot_radius))
+                   max(lane_spacing, (2.0 + MARGIN) * robot_radius))
 
     def conflicting_pillars(self, robot_radius: float) -> np.ndarray:
         """
         Return the (c, 2) index pairs j < l of pillars that break condition (c).
 
-        Condition (c): |p(q_j) - p(q_l)| >= w_j + w_l + 2R or
-        |h(q_j) - h(q_l)| >= z_j + z_l + 2R, z the zone half-heights.
+        Condition (c): |p(q_j) - p(q_l)| >= w_j + w_l + 2R + nu or
+        |h(q_j) - h(q_l)| >= z_j + z_l + 2R + nu, z the zone half-heights.
         """
         first, second = np.triu_indices(self.reach.size, 1)
+        apart = (2.0 + MARGIN) * robot_radius
         wide = (np.abs(self.pillar_projections[first] - self.pillar_projections[second])
-                >= self.reach[first] + self.reach[second] + 2 * robot_radius)
+                >= self.reach[first] + self.reach[second] + apart)
         tall = (np.abs(self.pillar_offsets[first] - self.pillar_offsets[second])
-                >= self.zone[first] + self.zone[second] + 2 * robot_radius)
+                >= self.zone[first] + self.zone[second] + apart)
         bad = ~(wide | tall)
         return np.stack([first[bad], second[bad]], axis=1)
 
@@ -180,7 +192,7 @@ class Rise:
     lift: np.ndarray
     shift: np.ndarray
 
-    def positions(self, configuration: np.ndarray, frame: 'Frame') -> np.ndarray:
+    def positions(self, configuration: np.ndarray, frame: Frame) -> np.ndarray:
         """Return the (B + 1, k, d) breakpoints: C, then the robots after each push/rise."""
         moved = (configuration[None] + self.shift[..., None] * frame.e1
                  + self.lift[:, None, None] * frame.e2)

@@ -17,10 +17,11 @@ import numpy.typing as npt
 from scipy.spatial import cKDTree
 
 from . import discs
-from .certificate import certify, certify_bodies, Clearance
+from .certificate import certify, certify_bodies, Clearance, RELATIVE_RESOLUTION
 from .complexity import domain_range, sequential_complexity
 from .deformations import desingularize, desingularizing_shift, spread
 from .errors import ErrorCode, PlanningError
+from .refine import block_count, Bodies, refine as refine_motion, Refinement
 from .sections import compose, lane_heights, SCHEDULES, segment_times
 from .space import Workspace
 from .strata import epsilon, projection_count, projection_gaps
@@ -50,17 +51,21 @@ class Samples:
 
 
 class Plan:
-    """A synchronous collision-free motion through C_1..C_n, stored as breakpoints."""
+    """
+    A synchronous collision-free motion through C_1..C_n, stored as breakpoints.
 
-    def __init__(self, workspace: Workspace, configurations: np.ndarray, times: np.ndarray,
+    Built by one of its named constructors: ``axis`` (the paper's and the spread
+    variant's construction), ``discs`` (the discs variant's) or ``refined`` (a
+    construction's motion after core.refine; ``raw`` is then that construction's
+    Plan and ``margin`` the gap the refinement keeps).
+    """
+
+    def __init__(self, *, workspace: Workspace, configurations: np.ndarray, times: np.ndarray,
                  positions: np.ndarray, leg_names: tuple[str, ...],
-                 projection_counts: np.ndarray, lanes: np.ndarray, spacing: np.ndarray | None,
-                 waypoint_indices: np.ndarray | None = None) -> None:
-        """
-        Keep the breakpoints and the data the derived attributes need.
-
-        waypoint_indices defaults to the same number of legs in every segment.
-        """
+                 waypoint_indices: np.ndarray, projection_counts: np.ndarray,
+                 lanes: np.ndarray, spacing: np.ndarray | None,
+                 raw: 'Plan | None' = None, margin: float | None = None) -> None:
+        """Keep the breakpoints and the data the derived attributes need."""
         n, k, d = configurations.shape
         r = workspace.obstacle_count
         self.workspace = workspace
@@ -68,8 +73,6 @@ class Plan:
         self.times = times
         self.positions = positions
         self.leg_names = leg_names
-        if waypoint_indices is None:
-            waypoint_indices = np.arange(n) * (len(leg_names) // (n - 1))
         self.waypoint_indices = waypoint_indices
         self.projection_counts = projection_counts
         self.domain = int(projection_counts.sum())
@@ -83,6 +86,42 @@ class Plan:
         self.variant = workspace.variant
         self.lanes = lanes
         self._spacing = spacing
+        self.raw = raw
+        self.margin = margin
+
+    @classmethod
+    def axis(cls, workspace: Workspace, configurations: np.ndarray, positions: np.ndarray,
+             projection_counts: np.ndarray, lanes: np.ndarray,
+             spacing: np.ndarray) -> 'Plan':
+        """Return the paper's or spread variant's plan: its schedule's legs in every segment."""
+        n = len(configurations)
+        schedule = SCHEDULES[workspace.variant]
+        legs = len(schedule.legs)
+        return cls(workspace=workspace, configurations=configurations,
+                   times=segment_times(n, schedule.fractions), positions=positions,
+                   leg_names=schedule.legs * (n - 1), waypoint_indices=np.arange(n) * legs,
+                   projection_counts=projection_counts, lanes=lanes, spacing=spacing)
+
+    @classmethod
+    def discs(cls, workspace: Workspace, configurations: np.ndarray,
+              section: discs.DiscSection, projection_counts: np.ndarray) -> 'Plan':
+        """Return the discs variant's plan, its legs timed by their length."""
+        return cls(workspace=workspace, configurations=configurations,
+                   times=length_times(section.positions, section.waypoint_indices),
+                   positions=section.positions, leg_names=section.leg_names,
+                   waypoint_indices=section.waypoint_indices,
+                   projection_counts=projection_counts, lanes=section.lane_heights,
+                   spacing=None)
+
+    @classmethod
+    def refined(cls, raw: 'Plan', refinement: Refinement) -> 'Plan':
+        """Return raw's refined plan: same domain, lanes and leg names (of the legs it splits)."""
+        return cls(workspace=raw.workspace, configurations=raw.configurations,
+                   times=refinement.times, positions=refinement.positions,
+                   leg_names=tuple(raw.leg_names[leg] for leg in refinement.base_legs.tolist()),
+                   waypoint_indices=refinement.waypoint_indices,
+                   projection_counts=raw.projection_counts, lanes=raw.lanes,
+                   spacing=raw._spacing, raw=raw, margin=refinement.margin)
 
     @cached_property
     def clearance(self) -> Clearance:
@@ -217,13 +256,16 @@ class Plan:
         return Samples(values, positions, kept[self.waypoint_indices] * step)
 
 
-def plan(workspace: Workspace, configurations: npt.ArrayLike, certify: bool = True) -> Plan:
+def plan(workspace: Workspace, configurations: npt.ArrayLike, certify: bool = True,
+         refine: bool = True) -> Plan:
     """
     Return the Plan through configurations (n, k, d) in workspace, or raise PlanningError.
 
-    With certify (the default) the exact certificate is computed at once and a
-    plan below workspace.required_clearance is refused (its gap when robots or
-    obstacles have a radius).
+    With refine (the default) the construction's motion is refined (core.refine):
+    shorter, with a gap never below the construction's own exact min_gap, in
+    the same domain. With certify (the default) the exact certificate is
+    computed at once and a plan below workspace.required_clearance is refused
+    (its gap when robots or obstacles have a radius).
     """
     configurations = validate_configurations(configurations, workspace.obstacles,
                                              workspace.robot_radius, workspace.obstacle_radii)
@@ -231,9 +273,12 @@ def plan(workspace: Workspace, configurations: npt.ArrayLike, certify: bool = Tr
     gaps = projection_gaps(projections, workspace.obstacle_projections)
     counts = projection_count(gaps)
     if workspace.variant == 'discs':
-        result = _disc_plan(workspace, configurations, counts)
+        result = Plan.discs(workspace, configurations,
+                            discs.section(configurations, workspace.disc_layout), counts)
     else:
         result = _axis_plan(workspace, configurations, projections, gaps, counts)
+    if refine:
+        result = _refined(result)
     if certify:
         _check_required_clearance(result)
     return result
@@ -257,18 +302,25 @@ def _axis_plan(workspace, configurations, projections, gaps, counts):
         projections = spread_projections
     stages.append(frame.axis_points(projections))
     lanes = lane_heights(k, r, workspace.lane_spacing, workspace.lane_base, workspace.variant)
-    positions = compose(stages, lanes, frame.e2)
-    schedule = SCHEDULES[workspace.variant]
-    return Plan(workspace, configurations, segment_times(n, schedule.fractions), positions,
-                schedule.legs * (n - 1), counts, lanes, spacing)
+    return Plan.axis(workspace, configurations, compose(stages, lanes, frame.e2), counts, lanes,
+                     spacing)
 
 
-def _disc_plan(workspace, configurations, counts):
-    """Return the 'discs' variant's Plan (core.discs), its legs timed by their length."""
-    disc = discs.section(configurations, workspace.disc_layout)
-    times = length_times(disc.positions, disc.waypoint_indices)
-    return Plan(workspace, configurations, times, disc.positions, disc.leg_names, counts,
-                disc.lane_heights, None, disc.waypoint_indices)
+def _refined(raw):
+    """
+    Return raw refined against its own exact gap (core.refine, doc/design.md section 14).
+
+    Beyond refine.MAX_ROBOTS robots raw itself (its raw attribute None says so).
+    """
+    if block_count(raw.positions.shape[1]) == 0:
+        return raw
+    workspace = raw.workspace
+    k = raw.positions.shape[1]
+    radii = np.concatenate([np.full(k, workspace.robot_radius), workspace.obstacle_radii])
+    rounding = RELATIVE_RESOLUTION * float(np.abs(raw.positions).max(initial=1.0))
+    bodies = Bodies(workspace.obstacles, radii, raw.min_gap, rounding)
+    return Plan.refined(raw, refine_motion(raw.times, raw.positions, raw.waypoint_indices,
+                                           bodies))
 
 
 def _check_required_clearance(result):

@@ -62,7 +62,7 @@ from ..ros.snapshot import Snapshot
 from ..ros.snapshot import take_snapshot
 from ..ros.wording import ObstacleNames
 # rmw_fastrtps waits up to 100 ms for the client's response reader to be matched,
-# then drops the reply; rclpy reports that with this warning (doc/design.md section 14).
+# then drops the reply; rclpy reports that with this warning (doc/design.md section 15).
 SEND_TIMEOUT_WARNING = 'failed to send response (timeout)'
 # Attempts at sending one reply: up to 1 s for a new client's reader to be matched.
 SEND_ATTEMPTS = 10

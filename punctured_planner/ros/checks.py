@@ -139,7 +139,10 @@ def _check_limits(settings: PlannerSettings, n: int, counts: list[int], samples:
         fail(ErrorCode.REQUEST_OVER_LIMITS, 'samples_per_leg %d is more than %d'
              % (samples, MAX_SAMPLES_PER_LEG))
     schedule = SCHEDULES.get(settings.core_variant)
-    if schedule is not None:  # 'discs' has no fixed legs: checked once planned
+    # The construction's breakpoints, fewer than the refined plan's: an early refusal
+    # before planning; the answer's own count is checked once planned ('discs' has no
+    # fixed legs, so only then).
+    if schedule is not None:
         check_poses(settings, k, schedule.breakpoint_count(n), samples)
 
 

@@ -33,6 +33,7 @@ import yaml
 
 _KINDS = {
     'string': ParameterType.PARAMETER_STRING,
+    'bool': ParameterType.PARAMETER_BOOL,
     'integer': ParameterType.PARAMETER_INTEGER,
     'double': ParameterType.PARAMETER_DOUBLE,
     'string_array': ParameterType.PARAMETER_STRING_ARRAY,
@@ -53,7 +54,7 @@ class Spec:
     """
 
     name: str
-    kind: str  # 'string', 'integer', 'double', 'string_array', 'double_array'
+    kind: str  # 'string', 'bool', 'integer', 'double', 'string_array', 'double_array'
     default: object
     description: str
     low: Any = None
@@ -116,6 +117,10 @@ def _coerce(spec: Spec, value: object) -> Any:
     if spec.kind == 'string':
         if not isinstance(value, str):
             raise ValueError('%s must be a string, got %r' % (spec.name, value))
+        return value
+    if spec.kind == 'bool':
+        if not isinstance(value, bool):
+            raise ValueError('%s must be true or false, got %r' % (spec.name, value))
         return value
     if spec.kind == 'integer':
         if not isinstance(value, int) or isinstance(value, bool):

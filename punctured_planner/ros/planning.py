@@ -29,7 +29,6 @@ from .wording import RequestNames
 from .. import core
 from ..core import ErrorCode
 from ..core import PlanningError
-from ..core import SCHEDULES
 from ..core import Workspace
 
 
@@ -120,7 +119,8 @@ class PlanSequenceHandler:
         d = snapshot.settings.dimension
         workspace = self.workspace(snapshot.settings,
                                    conversions.leading_coordinates(snapshot.obstacles.points, d))
-        return core.plan(workspace, conversions.leading_coordinates(checked.positions, d))
+        return core.plan(workspace, conversions.leading_coordinates(checked.positions, d),
+                         refine=snapshot.settings.refine)
 
     @staticmethod
     def _answer(response: Any, gathered: checks.Gathered, checked: checks.Checked,
@@ -130,9 +130,9 @@ class PlanSequenceHandler:
         planning_time = time.perf_counter() - started
         start_ns = int(now_ns) + int(round(planning_time * 1e9))
         max_speed = gathered.max_speed
-        if settings.core_variant not in SCHEDULES:
-            checks.check_poses(settings, gathered.counts[0], len(the_plan.times),
-                               gathered.samples_per_leg)
+        # The plan's own breakpoints: the refinement's knots add to any schedule's.
+        checks.check_poses(settings, gathered.counts[0], len(the_plan.times),
+                           gathered.samples_per_leg)
         with np.errstate(over='ignore', divide='ignore', invalid='ignore'):
             duration = the_plan.duration(max_speed)
         checks.check_duration(duration, max_speed, start_ns)

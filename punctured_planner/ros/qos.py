@@ -7,7 +7,7 @@ latest message. ``STATE``: robot state streams (odometry, ``robot_states``);
 best effort matches reliable and best-effort publishers alike.
 
 ``SERVER_QOS`` and ``CLIENT_QOS``: the ``plan_sequence`` service, the node's and
-its clients' (doc/design.md section 14). rmw_fastrtps (Jazzy) carries a service
+its clients' (doc/design.md section 15). rmw_fastrtps (Jazzy) carries a service
 on two DDS topics. The server has one response writer, and the response reader
 of every client of the service is matched with it: every reply reaches every
 client, and each client takes and drops the replies meant for the others. A

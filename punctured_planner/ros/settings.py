@@ -77,6 +77,11 @@ class PlannerSettings:
         'required_clearance', 'double', 0.0,
         'Refuse a plan whose certified minimum clearance is below this (m); 0 accepts '
         'every collision-free plan.', low=0.0, high=1e6).field()
+    refine: bool = Spec(
+        'refine', 'bool', True,
+        "Refine the construction's motion (doc/design.md section 14): shorter, in the "
+        "same domain, its gap never below the construction's; false: the construction's "
+        'own motion.', prose='true or false').field()
     max_state_age: float = Spec(
         'max_state_age', 'double', 0.5,
         'Largest age (s, by arrival on the node clock) of the robot state a '

@@ -1,7 +1,8 @@
 """
 Draw a plan on 2-D axes through a PlaneView: the static picture and the animation background.
 
-Layers, bottom to top: e1 axis, dashed lanes, robot paths with direction
+Layers, bottom to top: e1 axis, dashed lanes, (optionally) the construction's
+unrefined paths dashed, robot paths with direction
 arrows, obstacles (and their discs), numbered waypoints C_1..C_n (and the
 robots' discs there), the certified closest approach (smallest gap with radii).
 """
@@ -40,6 +41,14 @@ def draw_paths(ax, plan, view, colours, alpha=1.0, arrows=True):
             ax.add_patch(FancyArrowPatch(start + 0.42 * step, start + 0.58 * step,
                                          arrowstyle='-|>', mutation_scale=12, color=colour,
                                          lw=0, shrinkA=0, shrinkB=0, zorder=3))
+
+
+def draw_raw_paths(ax, plan, view, colours):
+    """Draw the construction's own motion of a refined plan (Plan.raw) dashed, under it."""
+    paths = view(plan.raw.positions)
+    for robot, colour in enumerate(colours):
+        ax.plot(paths[:, robot, 0], paths[:, robot, 1], ls='--', lw=0.9, color=colour,
+                alpha=0.6, zorder=1.5)
 
 
 def draw_obstacles(ax, plan, view, size=70):
@@ -93,9 +102,11 @@ def legend_handles(plan, colours, waypoints_numbered=True):
     return handles
 
 
-def draw_plan_2d(ax, plan, view, colours, path_alpha=1.0, arrows=True):
-    """Draw every layer of the plan on ax and label the axes by the view."""
+def draw_plan_2d(ax, plan, view, colours, path_alpha=1.0, arrows=True, raw=False):
+    """Draw every layer of the plan on ax, axes labelled by the view (raw: Plan.raw dashed)."""
     draw_frame_lines(ax, plan, view, colours)
+    if raw and plan.raw is not None:
+        draw_raw_paths(ax, plan, view, colours)
     draw_paths(ax, plan, view, colours, alpha=path_alpha, arrows=arrows)
     draw_obstacles(ax, plan, view)
     draw_waypoints(ax, plan, view, colours)

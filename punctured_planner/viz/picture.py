@@ -50,8 +50,12 @@ def plan_title(plan, title=None):
     return '\n'.join(lines)
 
 
-def plan_figure(plan, dpi=100, title=None, path_alpha=1.0, arrows=True):
-    """Return (figure, axes list) with the whole plan drawn; the caller saves or animates it."""
+def plan_figure(plan, dpi=100, title=None, path_alpha=1.0, arrows=True, raw=False):
+    """
+    Return (figure, axes list) with the whole plan drawn; the caller saves or animates it.
+
+    raw also draws a refined plan's unrefined motion (Plan.raw), dashed, on the 2-D views.
+    """
     d = plan.positions.shape[2]
     colours = robot_colours(plan.positions.shape[1])
     view = plane_view(plan)
@@ -61,13 +65,14 @@ def plan_figure(plan, dpi=100, title=None, path_alpha=1.0, arrows=True):
         draw_plan_3d(space, plan, colours, path_alpha=path_alpha, arrows=arrows)
         space.set_title('3-D view')
         top = figure.add_subplot(1, 2, 2)
-        draw_plan_2d(top, plan, view, colours, path_alpha=path_alpha, arrows=arrows)
+        draw_plan_2d(top, plan, view, colours, path_alpha=path_alpha, arrows=arrows, raw=raw)
         top.set_title('top view (x, y)')
         axes = [space, top]
     else:
         figure = new_figure(9.5, 6.8, dpi)
         plane = figure.add_subplot(1, 1, 1)
-        draw_plan_2d(plane, plan, view, colours, path_alpha=path_alpha, arrows=arrows)
+        draw_plan_2d(plane, plan, view, colours, path_alpha=path_alpha, arrows=arrows,
+                     raw=raw)
         if d > 3:
             plane.set_title('projection on the frame plane (e1, e2)')
         axes = [plane]
@@ -77,8 +82,8 @@ def plan_figure(plan, dpi=100, title=None, path_alpha=1.0, arrows=True):
     return figure, axes
 
 
-def render_png(plan, path, title=None, dpi=100):
-    """Draw the plan into a PNG file at path and return the path."""
-    figure, _ = plan_figure(plan, dpi=dpi, title=title)
+def render_png(plan, path, title=None, dpi=100, raw=False):
+    """Draw the plan into a PNG file at path and return the path (raw: see plan_figure)."""
+    figure, _ = plan_figure(plan, dpi=dpi, title=title, raw=raw)
     figure.savefig(path, dpi=dpi, format='png')
     return path

@@ -1,0 +1,105 @@
+"""
+The frame (o, e1, e2) the algorithm works in (doc/design.md section 4).
+
+The paper normalises the obstacles onto the e1 axis and writes p(x) for the
+first coordinate (Section 3). For arbitrary obstacles we pick a frame in which
+the obstacles' e1 projections are pairwise distinct; robots project onto the
+line o + R e1. The frame is fixed per workspace, never per query, so the
+domains of continuity are well defined.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from .errors import ErrorCode, PlanningError
+
+_ORTHONORMAL_TOLERANCE = 1e-9
+
+
+@dataclass(frozen=True, eq=False)
+class Frame:
+    """
+    Origin o and orthonormal directions e1 (projection axis), e2 (lane direction).
+
+    Compared by identity (eq=False): its fields are numpy arrays, whose == is
+    elementwise; a workspace's frame is one object for all its plans.
+    """
+
+    origin: np.ndarray
+    e1: np.ndarray
+    e2: np.ndarray
+
+    def project(self, points: npt.ArrayLike) -> np.ndarray:
+        """Return p(x) = <x - o, e1> for points of shape (..., d)."""
+        return (np.asarray(points, dtype=float) - self.origin) @ self.e1
+
+    def offset(self, points: npt.ArrayLike) -> np.ndarray:
+        """Return the e2 offset <x - o, e2> for points of shape (..., d)."""
+        return (np.asarray(points, dtype=float) - self.origin) @ self.e2
+
+    def axis_points(self, projections: npt.ArrayLike) -> np.ndarray:
+        """Return o + p e1 for projections of shape (...,): the points of the axis."""
+        return self.origin + np.asarray(projections, dtype=float)[..., None] * self.e1
+
+
+def _complement_direction(e1):
+    """Return a unit vector orthogonal to e1: the least aligned coordinate axis, orthogonalised."""
+    axis = np.zeros_like(e1)
+    axis[int(np.argmin(np.abs(e1)))] = 1.0
+    e2 = axis - (axis @ e1) * e1
+    return e2 / np.linalg.norm(e2)
+
+
+def _moment_curve_directions(dimension, count):
+    """
+    Return `count` deterministic unit directions (1, s, s^2, ...) on the moment curve.
+
+    Two distinct points share a projection on (1, s, ..., s^{d-1}) only for the at
+    most d - 1 roots s of a nonzero polynomial, so among count > C(r, 2) (d - 1)
+    distinct values of s at least one separates all r obstacles.
+    """
+    s = np.tan(np.pi * (np.arange(count) + 0.5) / count - np.pi / 2)
+    directions = s[:, None] ** np.arange(dimension)[None, :]
+    return directions / np.linalg.norm(directions, axis=1, keepdims=True)
+
+
+def choose_frame(obstacles: np.ndarray) -> Frame:
+    """
+    Return the default frame for obstacles (r, d): deterministic, fixed per obstacle set.
+
+    The coordinate axes (o = 0, e1 = x, e2 = y) whenever the obstacles' x
+    coordinates are distinct; otherwise the next coordinate axis that works;
+    otherwise the moment-curve direction that maximises the smallest gap between
+    obstacle projections.
+    """
+    r, d = obstacles.shape
+    origin = np.zeros(d)
+    for a in range(d):
+        if r < 2 or np.all(np.diff(np.sort(obstacles[:, a])) > 0):
+            e1 = np.zeros(d)
+            e1[a] = 1.0
+            e2 = np.zeros(d)
+            e2[(a + 1) % d] = 1.0
+            return Frame(origin, e1, e2)
+    count = max(16, (r * (r - 1) // 2) * (d - 1) + 1)
+    directions = _moment_curve_directions(d, count)
+    gaps = np.diff(np.sort(obstacles @ directions.T, axis=0), axis=0).min(axis=0)
+    e1 = directions[int(np.argmax(gaps))]
+    return Frame(origin, e1, _complement_direction(e1))
+
+
+def checked_frame(frame: Frame | tuple, dimension: int) -> Frame:
+    """Return a Frame or (origin, e1, e2) as a Frame, dimension and orthonormality checked."""
+    if isinstance(frame, Frame):
+        frame = (frame.origin, frame.e1, frame.e2)
+    origin, e1, e2 = (np.asarray(v, dtype=float).reshape(-1) for v in frame)
+    if not (origin.size == e1.size == e2.size == dimension):
+        raise PlanningError(ErrorCode.INVALID_REQUEST,
+                            f'frame vectors must have dimension {dimension}')
+    gram = np.array([[e1 @ e1, e1 @ e2], [e2 @ e1, e2 @ e2]])
+    if not (np.all(np.isfinite(gram)) and np.all(np.isfinite(origin))
+            and np.allclose(gram, np.eye(2), atol=_ORTHONORMAL_TOLERANCE)):
+        raise PlanningError(ErrorCode.INVALID_REQUEST, 'frame e1, e2 must be orthonormal')
+    return Frame(origin, e1, e2)

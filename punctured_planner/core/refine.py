@@ -1,0 +1,392 @@
+"""
+The refinement: a continuous, certified shortening of every plan (doc/design.md section 14).
+
+The construction fixes which domain a request is in and which way round each
+robot goes; the geometry inside that is free. The refined motion is
+
+    y(tau) = x(tau) + delta(tau),
+
+x the construction's motion and delta a displacement field, piecewise linear in
+tau with knots at fixed fractions j / K of every segment C_m -> C_{m+1} and zero
+at the configurations. y is piecewise linear on the union of x's breakpoints
+and the knots, so the certificate stays exact, and the configurations stay
+breakpoints, unchanged.
+
+delta is built by a fixed schedule: BLOCKS blocks of SWEEPS red-black sweeps of
+over-relaxed smoothing (each knot towards its neighbours' midpoint). A block
+first computes every knot's caps from the exact slack (gap minus the margin
+g0, the construction's own exact min_gap) over the two knot intervals its hat
+function covers: a quarter of its smallest robot-pair slack, half of its
+smallest robot-pillar slack; each knot's total move in the block is split into
+the fleet's common translation (which robot pairs do not feel) and each
+robot's own part, each clipped to its caps and to a fixed step. Gap distance
+is 1-Lipschitz in each robot's position, so no gap falls below g0 (the caps
+lemma). Every quantity is a continuous function of the input; pairs are left
+out only where their cap term provably exceeds the step (so leaving them out
+changes nothing), and the number of blocks, sweeps and knots is fixed, so the
+map stays continuous on every domain (doc/design.md section 14).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from .certificate import certify, segment_minimum
+
+# Knots per segment: the field is piecewise linear on the j / KNOTS fractions.
+KNOTS = 64
+# A block computes the caps once (the costly part: the exact slack of every pair near
+# enough to matter), then runs SWEEPS red-black sweeps of over-relaxed smoothing
+# (successive over-relaxation: O(KNOTS) sweeps where plain smoothing, like diffusion,
+# needs O(KNOTS^2)), each knot's total move in the block clipped to its caps. Fresh caps
+# let robots use the room they made, so more blocks shorten more; but a block's caps
+# follow the motion (a pillar cap moves by up to half of what the motion moves), so
+# each block can amplify a change of input, and BLOCKS bounds that (measured: a 1e-7
+# change moves the refined motion 5 - 22x that, the construction's 2 - 4x).
+BLOCKS, SWEEPS = 12, 6
+# A block's cost grows like k^2 (all pairs near each other somewhere): beyond FULL_ROBOTS
+# robots the blocks fall as FULL_ROBOTS / k, and beyond MAX_ROBOTS none is run (the
+# construction's plan is returned; k is fixed on a domain, so this keeps continuity).
+FULL_ROBOTS, MAX_ROBOTS = 64, 256
+# The longest move of a knot in one block, as a share of the fleet's scale.
+STEP = 0.2
+# Over-relaxation factor: about 2 / (1 + sin(pi / KNOTS)) is the classical optimum; less
+# is steadier under the caps.
+RELAXATION = 1.9
+# Caps: a quarter of a robot pair's slack (each robot moves at most that, so the pair's
+# distance changes by at most half of it), half of a robot-pillar slack.
+PAIR_SHARE, PILLAR_SHARE = 0.25, 0.5
+# The common translation of a knot may be at most this multiple of its smallest pair cap
+# (4: the smallest pair slack itself; more would make the caps steep, and continuity
+# weaker, for nothing but rounding).
+_TRANSLATION = 4.0
+# Up to this many robots every pair is checked on every interval (pruning costs more).
+_ALL_PAIRS = 24
+
+
+@dataclass(frozen=True, eq=False)
+class Bodies:
+    """
+    What the gaps are measured against: pillars (r, d), radii (k + r,), the margin g0.
+
+    rounding is the slack treated as none (the resolution of the coordinates).
+    """
+
+    obstacles: np.ndarray
+    radii: np.ndarray
+    margin: float
+    rounding: float
+
+
+@dataclass(frozen=True, eq=False)
+class Refinement:
+    """
+    The refined motion: breakpoint parameters (U,), positions (U, k, d), waypoints' indices.
+
+    base_legs (U - 1,) names the construction's leg each refined leg lies in;
+    margin is the gap every pair keeps: g0, or the construction's motion's own
+    exact gap on the refined breakpoints where rounding puts that a few ulps
+    lower (the same motion, evaluated at more points).
+    """
+
+    times: np.ndarray
+    positions: np.ndarray
+    waypoint_indices: np.ndarray
+    base_legs: np.ndarray
+    margin: float
+
+
+@dataclass(frozen=True, eq=False)
+class _Union:
+    """x on the union of its breakpoints and the knots: times, positions, base legs."""
+
+    times: np.ndarray
+    positions: np.ndarray
+    base_legs: np.ndarray
+    waypoint_indices: np.ndarray
+
+
+def knot_times(segments: int, per_segment: int) -> np.ndarray:
+    """Return the ((n - 1) K + 1,) knots (m + j / K) / (n - 1): fixed fractions of segments."""
+    index = np.arange(segments * per_segment + 1)
+    m, j = np.divmod(index, per_segment)
+    # The last knot is (n - 1 + 0 / K) / (n - 1) = 1 exactly, like every waypoint.
+    return (m + j / per_segment) / segments
+
+
+def union_motion(times: np.ndarray, positions: np.ndarray,
+                 waypoint_indices: np.ndarray, knots: np.ndarray) -> _Union:
+    """Return x on the union of its breakpoints and the knots; waypoints kept bit for bit."""
+    extra = knots[~np.isin(knots, times)]
+    leg = np.clip(np.searchsorted(times, extra, side='right') - 1, 0, times.size - 2)
+    fraction = ((extra - times[leg]) / (times[leg + 1] - times[leg]))[:, None, None]
+    # (1 - f) a + f b, as Plan.position evaluates x.
+    inserted = (1.0 - fraction) * positions[leg] + fraction * positions[leg + 1]
+    all_times = np.concatenate([times, extra])
+    order = np.argsort(all_times, kind='stable')
+    rank = np.empty_like(order)
+    rank[order] = np.arange(order.size)
+    base = np.concatenate([np.arange(times.size), leg])[order]
+    # A refined leg lies in the base leg of its start point: breakpoint i starts base
+    # leg i, a knot inserted into base leg l starts the rest of l.
+    return _Union(all_times[order], np.concatenate([positions, inserted])[order],
+                  np.minimum(base[:-1], times.size - 2), rank[waypoint_indices])
+
+
+@dataclass(frozen=True, eq=False)
+class _Knots:
+    """The knots: times (N,), each breakpoint's knot interval (U,), fraction, index in U."""
+
+    times: np.ndarray
+    interval: np.ndarray
+    fraction: np.ndarray
+    points: np.ndarray
+
+    @classmethod
+    def of(cls, union: _Union, segments: int) -> '_Knots':
+        """Return the KNOTS knots a segment on the union motion."""
+        knots = knot_times(segments, KNOTS)
+        interval = np.clip(np.searchsorted(knots, union.times, side='right') - 1, 0,
+                           knots.size - 2)
+        fraction = (union.times - knots[interval]) / (knots[interval + 1] - knots[interval])
+        # Every knot is a breakpoint of the union.
+        points = np.searchsorted(union.times, knots)
+        return cls(knots, interval, np.clip(fraction, 0.0, 1.0), points)
+
+    def field(self, values: np.ndarray) -> np.ndarray:
+        """Return (U, k, d) the field at the breakpoints from its values (N, k, d) at knots."""
+        f = self.fraction[:, None, None]
+        return (1.0 - f) * values[self.interval] + f * values[self.interval + 1]
+
+
+def _enclosing_balls(motion, knots):
+    """
+    Return (centres (N - 1, k, d), radii (N - 1, k)): a ball holding each robot per interval.
+
+    The centre is the midpoint of the robot's positions at the interval's two
+    knots; the radius the farthest breakpoint from it, so the whole piece of
+    motion (linear between breakpoints) lies in the ball. Both are continuous
+    in the motion.
+    """
+    centres = 0.5 * (motion[knots.points[:-1]] + motion[knots.points[1:]])
+    owner = np.minimum(knots.interval, centres.shape[0] - 1)
+    distance = np.sqrt(((motion - centres[owner]) ** 2).sum(axis=2))
+    radii = np.maximum.reduceat(distance, knots.points[:-1], axis=0)
+    # reduceat stops short of each interval's end knot, which starts the next interval.
+    end = np.sqrt(((motion[knots.points[1:]] - centres) ** 2).sum(axis=2))
+    return centres, np.maximum(radii, end)
+
+
+def _pair_candidates(centres, radii, reach):
+    """
+    Return (interval, a, b), a < b, of the robot pairs whose balls come within reach.
+
+    Few robots: every pair. Many: one tree over all (interval, robot) balls,
+    intervals set far apart along an extra axis. A pair left out is more than
+    reach apart over its whole interval.
+    """
+    intervals, k, d = centres.shape
+    if k <= _ALL_PAIRS:
+        a, b = np.triu_indices(k, 1)
+        interval = np.repeat(np.arange(intervals), a.size)
+        a, b = np.tile(a, intervals), np.tile(b, intervals)
+    else:
+        flat = centres.reshape(-1, d)
+        span = float(np.ptp(flat, axis=0).max()) + 2 * float(radii.max()) + reach + 1.0
+        apart = (np.repeat(np.arange(intervals), k) * 2 * span)[:, None]
+        found = cKDTree(np.concatenate([flat, apart], axis=1)).query_pairs(
+            reach + 2 * float(radii.max()), output_type='ndarray').reshape(-1, 2)
+        interval, a = np.divmod(found.min(axis=1), k)
+        b = found.max(axis=1) % k
+    distance = np.sqrt(((centres[interval, a] - centres[interval, b]) ** 2).sum(axis=1))
+    near = distance - radii[interval, a] - radii[interval, b] < reach
+    return interval[near], a[near], b[near]
+
+
+def _interval_legs(knots, interval):
+    """Return (legs, owner): the union legs of each listed interval, and the list entry."""
+    count = (knots.points[1:] - knots.points[:-1])[interval]
+    owner = np.repeat(np.arange(interval.size), count)
+    first = np.repeat(knots.points[interval] - (np.cumsum(count) - count), count)
+    return first + np.arange(owner.size), owner
+
+
+def _leg_minima(planes, legs, a, b):
+    """
+    Return the smallest |x_a - x_b| over each leg, exactly.
+
+    planes is the motion coordinate first (d, U, k); b is robots, or a fixed
+    point per entry (d, entries).
+    """
+    start = planes[:, legs, a] - (planes[:, legs, b] if b.ndim == 1 else b)
+    end = planes[:, legs + 1, a] - (planes[:, legs + 1, b] if b.ndim == 1 else b)
+    end -= start
+    squared, _ = segment_minimum(start, end)
+    return np.sqrt(squared)
+
+
+class _Caps:
+    """
+    Each robot's caps at every knot: (N, k) for its robot pairs and for the pillars.
+
+    From the exact slack (closed form per leg) of robot pairs and robot-pillar
+    pairs over each knot interval: a quarter (PAIR_SHARE) of the smallest pair
+    slack, half (PILLAR_SHARE) of the smallest pillar slack, over the two
+    intervals each knot's hat covers; 0 at the configurations. A pair whose
+    enclosing balls already keep a slack of 4 step is left out: its cap term
+    would be at least step (2 step for a pillar), which the block's caps never
+    exceed, so leaving it out changes nothing (design, 14).
+    """
+
+    def __init__(self, motion, knots, bodies, step):
+        """Compute the caps for the motion at the union's breakpoints (U, k, d)."""
+        centres, radii = _enclosing_balls(motion, knots)
+        intervals, k, d = centres.shape
+        planes = np.ascontiguousarray(np.moveaxis(motion, 2, 0))
+        floor = bodies.margin + bodies.rounding
+        prune = 4 * step
+        pair = np.full((intervals, k), step)
+        if k > 1:
+            radius = bodies.radii[0]
+            interval, a, b = _pair_candidates(centres, radii, prune + 2 * radius + floor)
+            if interval.size:
+                legs, owner = _interval_legs(knots, interval)
+                slack = np.full(interval.size, np.inf)
+                np.minimum.at(slack, owner, _leg_minima(planes, legs, a[owner], b[owner]))
+                share = PAIR_SHARE * np.maximum(slack - 2 * radius - floor, 0.0)
+                np.minimum.at(pair, (interval, a), share)
+                np.minimum.at(pair, (interval, b), share)
+        pillar = np.full((intervals, k), 2 * step)
+        if len(bodies.obstacles):
+            pillars = bodies.obstacles
+            offsets = bodies.radii[:k][None, :, None] + bodies.radii[None, None, k:] + floor
+            ball = (np.sqrt(((centres[:, :, None, :] - pillars[None, None]) ** 2).sum(axis=3))
+                    - radii[:, :, None] - offsets)
+            interval, a, q = np.nonzero(ball < prune)
+            if interval.size:
+                legs, owner = _interval_legs(knots, interval)
+                slack = np.full(interval.size, np.inf)
+                np.minimum.at(slack, owner,
+                              _leg_minima(planes, legs, a[owner], pillars[q[owner]].T))
+                share = PILLAR_SHARE * np.maximum(slack - offsets[0, a, q], 0.0)
+                np.minimum.at(pillar, (interval, a), share)
+        self.pair, self.pillar = _knot_caps(pair), _knot_caps(pillar)
+
+
+def _knot_caps(bound):
+    """Return (N, k) caps from interval bounds (N - 1, k): both intervals of each hat."""
+    caps = np.zeros((bound.shape[0] + 1, bound.shape[1]))
+    caps[1:-1] = np.minimum(bound[:-1], bound[1:])
+    caps[::KNOTS] = 0.0  # the configurations hold
+    return caps
+
+
+def _clipped(move, caps):
+    """Return the moves (..., d) scaled down to lengths <= caps (...); zero at cap 0."""
+    length = np.sqrt((move * move).sum(axis=-1))
+    over = length > caps
+    scale = np.where(over, caps / np.where(over, length, 1.0), 1.0)
+    return move * scale[..., None]
+
+
+class _Block:
+    """
+    The moves of one block: the fleet's common translation and each robot's own part.
+
+    A common translation leaves every robot pair's distance as it is (up to
+    rounding), so robot-pillar caps bound it: |common| <= half the smallest
+    pillar cap of the knot, <= step, and <= _TRANSLATION x its smallest pair
+    cap (0 where a pair has no slack, so rounding cannot take any); |own| <=
+    the pair cap, <= what common leaves of the pillar cap and <= step. Both
+    are totals over the block, so a robot's displacement at any instant of the
+    block stays within its caps (design, 14).
+    """
+
+    def __init__(self, caps, step):
+        """Fix the caps of the block."""
+        # A translation keeps pair distances, but only up to rounding: where a pair has no
+        # slack the common part must be exactly 0. Capping it by a multiple of the
+        # smallest pair cap does that and stays continuous.
+        self.common_cap = np.minimum(np.minimum(0.5 * caps.pillar.min(axis=1), step),
+                                     _TRANSLATION * caps.pair.min(axis=1))
+        self.pair, self.pillar, self.step = caps.pair, caps.pillar, step
+
+    def clip(self, wanted):
+        """
+        Return (common (N, d), own (N, k, d)): the wanted totals (N, k, d) within the caps.
+
+        common is the fleet's mean, clipped; own what each robot still wants, clipped.
+        """
+        common = _clipped(wanted.mean(axis=1), self.common_cap)
+        left = self.pillar - np.sqrt((common * common).sum(axis=1))[:, None]
+        own = _clipped(wanted - common[:, None], np.minimum(np.minimum(self.pair, left),
+                                                            self.step))
+        return common, own
+
+
+def _sweep(start, common, own, base_knots, block):
+    """
+    Return (common, own) after one red-black sweep of over-relaxed smoothing.
+
+    Each knot moves RELAXATION x the way to its neighbours' midpoint, the move
+    split into the fleet's mean and each robot's own part; knots of one parity
+    have no neighbour of the same parity, so each half sweep uses the other
+    half's newest values.
+    """
+    for parity in (1, 0):
+        current = base_knots + start + common[:, None] + own
+        index = np.arange(parity + (1 - parity) * 2, current.shape[0] - 1, 2)
+        move = RELAXATION * (0.5 * (current[index - 1] + current[index + 1]) - current[index])
+        wanted = common[:, None] + own
+        wanted[index] += move
+        common, own = block.clip(wanted)
+    return common, own
+
+
+def block_count(robot_count: int) -> int:
+    """Return the blocks for k robots: BLOCKS, fewer beyond FULL_ROBOTS, none beyond MAX."""
+    if robot_count > MAX_ROBOTS:
+        return 0
+    return max(1, BLOCKS * min(FULL_ROBOTS, robot_count) // max(robot_count, 1))
+
+
+def fleet_scale(configurations: np.ndarray, obstacles: np.ndarray) -> float:
+    """Return the side of the box of the configurations and pillars: the steps' length unit."""
+    points = np.concatenate([configurations.reshape(-1, configurations.shape[2]), obstacles])
+    return float((points.max(axis=0) - points.min(axis=0)).max())
+
+
+def refine(times: np.ndarray, positions: np.ndarray, waypoint_indices: np.ndarray,
+           bodies: Bodies) -> Refinement:
+    """
+    Return the refined motion of the construction's motion (times (V,), positions (V, k, d)).
+
+    Every gap of the result stays >= bodies.margin, the configurations are its
+    breakpoints exactly, and it is a continuous function of the input (module
+    docstring; doc/design.md section 14).
+    """
+    k, d = positions.shape[1:]
+    configurations = positions[waypoint_indices]
+    segments = len(waypoint_indices) - 1
+    union = union_motion(times, positions, waypoint_indices, knot_times(segments, KNOTS))
+    knots = _Knots.of(union, segments)
+    gap = certify(union.times, union.positions, bodies.obstacles,
+                  bodies.radii if np.any(bodies.radii > 0) else None).distance
+    bodies = Bodies(bodies.obstacles, bodies.radii, min(bodies.margin, gap), bodies.rounding)
+    scale = fleet_scale(configurations, bodies.obstacles)
+    base_knots = union.positions[knots.points]
+    values = np.zeros((knots.times.size, k, d))
+    motion = union.positions
+    step = STEP * scale
+    for _ in range(block_count(k)):
+        block = _Block(_Caps(motion, knots, bodies, step), step)
+        common, own = np.zeros((values.shape[0], d)), np.zeros_like(values)
+        for _ in range(SWEEPS):
+            common, own = _sweep(values, common, own, base_knots, block)
+        values = values + common[:, None] + own
+        # x + 0.0 is x: a robot held everywhere in an interval keeps x's breakpoints.
+        motion = union.positions + knots.field(values)
+    motion[union.waypoint_indices] = configurations
+    return Refinement(union.times, motion, union.waypoint_indices, union.base_legs,
+                      bodies.margin)

@@ -1,0 +1,133 @@
+"""
+The refinement (punctured_planner/core/refine.py, doc/design.md section 14).
+
+Over random and degenerate requests (shared projections, robots on a pillar's
+projection, tight lattices at exactly the discs condition) and every variant:
+the refined plan's exact gap never falls below its margin, the margin is the
+construction's own exact gap (up to the rounding of the same motion evaluated
+at more breakpoints), the configurations are breakpoints bit for bit, the
+domain is the construction's, the result is deterministic, and a 1e-7 change
+inside a domain moves the motion, as a function of normalised time, by at most
+100 times that.
+"""
+
+from core_strategies import lattice_requests, requests
+from hypothesis import assume, given, HealthCheck, settings, strategies as st
+import numpy as np
+from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
+import pytest
+
+PROPERTY = settings(max_examples=80, deadline=None,
+                    suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+VARIANTS = st.sampled_from(['paper', 'spread', 'discs'])
+RADII = st.sampled_from([0.0, 0.05])
+# The issue's continuity target: motion change / input change inside a domain.
+CONTINUITY = 100.0
+
+
+def workspace_for(obstacles, variant, radius):
+    """Return the Workspace of a generated request; radii only for 'discs'."""
+    radius = radius if variant == 'discs' else 0.0
+    return Workspace(obstacles, dimension=obstacles.shape[1], variant=variant,
+                     robot_radius=radius, obstacle_radius=radius)
+
+
+def refined(workspace, configurations):
+    """Return the refined plan, or reject the example if the input is refused."""
+    try:
+        return plan(workspace, configurations, certify=False)
+    except PlanningError:
+        assume(False)
+        raise
+
+
+def check_refinement(p):
+    """Assert the refinement's guarantees on one refined plan."""
+    raw = p.raw
+    assert p.min_gap >= p.margin, (p.min_gap, p.margin, p.gap)
+    assert p.margin <= raw.min_gap
+    assert p.margin >= raw.min_gap - p.clearance.resolution
+    assert np.array_equal(p.positions[p.waypoint_indices], p.configurations)
+    assert np.array_equal(p.times[p.waypoint_indices], raw.times[raw.waypoint_indices])
+    assert np.all(np.diff(p.times) >= 0)
+    assert np.array_equal(p.projection_counts, raw.projection_counts)
+    assert (p.domain, p.domain_index, p.domain_count, p.sequential_complexity) == (
+        raw.domain, raw.domain_index, raw.domain_count, raw.sequential_complexity)
+    assert len(p.leg_names) == p.times.size - 1
+
+
+@PROPERTY
+@given(requests(max_robots=6, max_obstacles=4, max_configurations=3), VARIANTS, RADII)
+def test_gap_waypoints_domain_on_random_and_degenerate_requests(request, variant, radius):
+    """Every guarantee on grids, shared columns, the lowest stratum and floats."""
+    obstacles, configurations, _ = request
+    p = refined(workspace_for(obstacles, variant, radius), configurations)
+    check_refinement(p)
+    again = refined(workspace_for(obstacles, variant, radius), configurations)
+    assert np.array_equal(again.positions, p.positions)
+    assert np.array_equal(again.times, p.times)
+
+
+@PROPERTY
+@given(lattice_requests())
+def test_gap_waypoints_domain_on_tight_lattices(case):
+    """At exactly the discs condition many pairs have no slack: they must not move."""
+    workspace, configurations = case
+    check_refinement(refined(workspace, configurations))
+
+
+@PROPERTY
+@given(requests(max_robots=5, max_obstacles=4, max_configurations=3, modes=('float',)),
+       VARIANTS, RADII, st.integers(0, 2 ** 31))
+def test_a_small_change_inside_a_domain_moves_the_refined_motion_little(request, variant,
+                                                                        radius, seed):
+    """Continuity, measured: a 1e-7 change that keeps every cp moves the motion <= 100x."""
+    obstacles, configurations, _ = request
+    assume(np.all(np.abs(configurations) < 1e3))
+    workspace = workspace_for(obstacles, variant, radius)
+    size = 1e-7
+    moved = configurations + np.random.default_rng(seed).uniform(-size, size,
+                                                                 configurations.shape)
+    before, after = refined(workspace, configurations), refined(workspace, moved)
+    assume(np.array_equal(before.projection_counts, after.projection_counts))
+    tau = np.linspace(0.0, 1.0, 3001)
+    change = np.abs(before.position(tau) - after.position(tau)).max()
+    assert change <= CONTINUITY * size, change / size
+
+
+def test_the_refined_motion_is_shorter_and_its_stamps_work():
+    """A realistic discs fleet: much shorter than the construction, timed and sampled as it."""
+    rng = np.random.default_rng(3)
+    pillars = np.array([[1.0, 1.0], [3.0, 2.5], [5.0, 1.2]])
+    starts = np.stack([np.linspace(0.2, 5.8, 6), np.full(6, -0.5)], axis=1)
+    goals = starts[rng.permutation(6)] + [0.0, 4.0]
+    workspace = Workspace(pillars, variant='discs', robot_radius=0.2, obstacle_radius=0.15)
+    p = plan(workspace, [starts, goals, starts])
+    raw = plan(workspace, [starts, goals, starts], refine=False)
+
+    def length(motion):
+        return np.linalg.norm(np.diff(motion.positions, axis=0), axis=2).sum()
+
+    assert length(p) < 0.7 * length(raw)
+    assert p.min_gap >= p.margin > 0
+    samples = p.sample(2, max_speed=0.5)
+    assert np.all(np.diff(samples.values) > 0)
+    assert np.array_equal(samples.positions[samples.waypoints], p.configurations)
+    assert p.duration(0.5) < raw.duration(0.5)
+
+
+def test_required_clearance_is_judged_on_the_refined_plan():
+    """A required gap above what the refined plan keeps is refused, naming the closest pair."""
+    pillars = np.array([[0.0, 0.0]])
+    request = [[[-2.0, -1.0], [2.0, -1.0]], [[2.0, 1.5], [-2.0, 1.5]]]
+    loose = Workspace(pillars, variant='discs', robot_radius=0.2, obstacle_radius=0.1)
+    p = plan(loose, request)
+    strict = Workspace(pillars, variant='discs', robot_radius=0.2, obstacle_radius=0.1,
+                       required_clearance=3.7)
+    with pytest.raises(PlanningError) as caught:
+        plan(strict, request)
+    assert caught.value.code == ErrorCode.CLEARANCE_BELOW_REQUIRED
+    assert p.min_gap >= p.margin
+    met = Workspace(pillars, variant='discs', robot_radius=0.2, obstacle_radius=0.1,
+                    required_clearance=0.3)
+    assert plan(met, request).min_gap >= 0.3
