@@ -3,10 +3,11 @@ Stress check of the clean stop: start, one call, SIGINT or SIGTERM at a random m
 
 For each install (the venv's console script; the colcon install built from a
 copy of this checkout with the README's command), ``--cycles`` times: start
-planner_node, wait for its service, send one call (k = 8 or 512 robots, n = 3),
-send SIGINT or SIGTERM a random 0-0.3 s after the call (before, during or after
-the plan), wait for the exit. Counts non-zero exits, tracebacks, segfaults and
-hangs (no exit within 40 s), and how many signals landed during a call.
+planner_node, wait for its service, send one call (k = 8 or 512 robots, n = 3) from a
+fresh ``punctured-planner call`` process, send SIGINT or SIGTERM a random 0-0.3 s
+after the node took the call (during or after the plan), wait for the exit. Counts non-zero exits, tracebacks, segfaults and
+hangs (no exit within 40 s), how many signals landed during a call and how many of those calls got their
+reply.
 Seeded; the logs of unclean cycles are kept. ``make test`` runs a few of the
 same cycles (test/test_clean_stop.py, test/test_colcon_build.py).
 
@@ -34,7 +35,7 @@ from stop_check import node_arguments  # noqa: E402
 from stop_check import run_cycle  # noqa: E402
 
 
-def stress(install, command, cycles, seed, cwd, env, client, executor, keep_dir):
+def stress(install, command, cycles, seed, cwd, env, client, caller, keep_dir):
     """Run the cycles of one install; print progress and the counts; return the failures."""
     rng = np.random.default_rng(seed)
     counts = collections.Counter()
@@ -42,8 +43,8 @@ def stress(install, command, cycles, seed, cwd, env, client, executor, keep_dir)
     started = time.monotonic()
     for number in range(cycles):
         namespace = '/pp_stress_%s_%d_%d' % (install, os.getpid(), number)
-        cycle = run_cycle(client, executor, command(namespace), env, namespace, log_path,
-                          draw(rng), rng, cwd=cwd)
+        cycle = run_cycle(client, command(namespace), env, namespace, log_path,
+                          draw(rng), rng, caller, cwd=cwd)
         counts[cycle.signal_name] += 1
         counts['during a call'] += cycle.during_call
         counts['during a call, answered'] += cycle.during_call and cycle.answered
@@ -52,6 +53,9 @@ def stress(install, command, cycles, seed, cwd, env, client, executor, keep_dir)
         counts['traceback'] += cycle.traceback
         counts['segfault'] += cycle.segfault
         counts['hang (killed)'] += cycle.returncode is None
+        if cycle.during_call and not cycle.answered:
+            print('  cycle %d: reply lost: %s' % (number, cycle.describe().splitlines()[0]),
+                  flush=True)
         if not cycle.clean:
             counts['unclean'] += 1
             kept = os.path.join(keep_dir, '%s_%03d.log' % (install, number))
@@ -82,12 +86,10 @@ def main(argv=None):
     os.environ.setdefault('ROS_LOG_DIR', tempfile.mkdtemp(prefix='pp_stress_log_'))
     keep_dir = tempfile.mkdtemp(prefix='pp_stress_')
     import rclpy
-    from rclpy.executors import SingleThreadedExecutor
     context = rclpy.context.Context()
     rclpy.init(context=context, args=[])
     client = rclpy.create_node('stress_client', context=context)
-    executor = SingleThreadedExecutor(context=context)
-    executor.add_node(client)
+    caller = [os.path.join(os.path.dirname(sys.executable), 'punctured-planner')]
     print('ROS_DOMAIN_ID %s; logs of unclean cycles in %s'
           % (os.environ['ROS_DOMAIN_ID'], keep_dir), flush=True)
     failures = 0
@@ -95,7 +97,7 @@ def main(argv=None):
         if args.install in ('venv', 'both'):
             script = os.path.join(os.path.dirname(sys.executable), 'planner_node')
             failures += stress('venv', lambda ns: [script] + node_arguments(ns), args.cycles,
-                               args.seed, None, dict(os.environ), client, executor, keep_dir)
+                               args.seed, None, dict(os.environ), client, caller, keep_dir)
         if args.install in ('colcon', 'both'):
             env = venv_env(os.environ)
             workspace = args.workspace or os.path.join(keep_dir, 'ws')
@@ -106,9 +108,8 @@ def main(argv=None):
                     return 1
             failures += stress(
                 'colcon', lambda ns: installed_node_command(workspace, node_arguments(ns)),
-                args.cycles, args.seed + 1, workspace, env, client, executor, keep_dir)
+                args.cycles, args.seed + 1, workspace, env, client, caller, keep_dir)
     finally:
-        executor.shutdown()
         client.destroy_node()
         rclpy.try_shutdown(context=context)
     return 1 if failures else 0

@@ -1,6 +1,9 @@
 """
 One stop cycle of a node process: start, one call, SIGINT or SIGTERM at a random moment.
 
+The call comes from a fresh ``punctured-planner call`` process each cycle, and
+the cycle records whether that process got its reply (doc/design.md section 16).
+
 Shared by the short check in ``make test`` (test/test_clean_stop.py, a few cycles
 per install) and the stress benchmark (bench/stop_stress.py, 300 cycles per
 install). A cycle is clean when the process exits 0 with no traceback in its
@@ -15,6 +18,7 @@ import time
 from typing import Optional
 
 import numpy as np
+import yaml
 
 # Seconds a stopped node may take to exit: its shutdown.STOP_TIMEOUT_SEC plus margin.
 STOP_TIMEOUT_SEC = 40.0
@@ -24,6 +28,8 @@ SIGNALS = (signal.SIGINT, signal.SIGTERM)
 ROBOTS = (8, 512)
 CONFIGURATIONS = 3
 MAX_DELAY_SEC = 0.3
+# Seconds the fresh client process waits for its reply.
+CALL_TIMEOUT_SEC = 15.0
 OBSTACLES = '[-2.0, 0.5, 0.0, 0.0, -0.5, 0.0, 2.5, 0.0, 0.0]'
 
 
@@ -98,49 +104,79 @@ def draw(rng):
             float(rng.uniform(0.0, MAX_DELAY_SEC)))
 
 
-def run_cycle(client_node, executor, command, env, namespace, log_path, choice, rng,
+def request_data(rng, k, n=CONFIGURATIONS):
+    """Return the request of :func:`random_request` as ``punctured-planner call`` reads it."""
+    request = random_request(rng, k, n)
+    return {'configurations': [
+        {'header': {'frame_id': 'map'},
+         'poses': [{'position': {'x': pose.position.x, 'y': pose.position.y}}
+                   for pose in configuration.poses]}
+        for configuration in request.configurations], 'max_speed': request.max_speed}
+
+
+def _wait_for_text(path, text, process, timeout_sec):
+    """Wait until the file at ``path`` holds ``text`` or ``process`` exited; return if it does."""
+    deadline = time.monotonic() + timeout_sec
+    while time.monotonic() < deadline:
+        with open(path, 'rb') as stream:
+            if text in stream.read():
+                return True
+        if process.poll() is not None:
+            return False
+        time.sleep(0.002)
+    return False
+
+
+def run_cycle(client_node, command, env, namespace, log_path, choice, rng, caller,
               cwd=None):
     """
     Run one cycle of ``command`` (a planner_node in ``namespace``); return a Cycle.
 
-    ``client_node`` and ``executor`` are the caller's rclpy node and its
-    executor; ``choice`` is (signal number, k, delay s) as :func:`draw` returns
-    it: the signal goes out ``delay`` seconds after the call, whose request of
-    k robots is drawn from ``rng``.
+    ``client_node`` (the caller's rclpy node) only waits for the service; the
+    call itself is a fresh ``caller`` process (the ``punctured-planner``
+    command as a list), as a fleet's one-shot tool would call: its reader is
+    matched for the first time when the reply goes out. ``choice`` is (signal
+    number, k, delay s) as :func:`draw` returns it: the signal goes out
+    ``delay`` seconds after the node logged the request, whose k robots are
+    drawn from ``rng``.
     """
     from punctured_planner_interfaces.srv import PlanSequence
     number, k, delay = choice
-    request = random_request(rng, k)
-    with open(log_path, 'wb') as log:
+    request_path = log_path + '.request.yaml'
+    with open(request_path, 'w') as stream:
+        yaml.safe_dump(request_data(rng, k), stream)
+    call_log_path = log_path + '.call'
+    with open(log_path, 'wb') as log, open(call_log_path, 'wb') as call_log:
         process = subprocess.Popen(command, env=env, cwd=cwd, stdout=log,
                                    stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
         client = client_node.create_client(PlanSequence, namespace + '/plan_sequence')
+        call = None
         try:
             served = client.wait_for_service(timeout_sec=30.0)
-            future = client.call_async(request)
-            sent = time.monotonic()
-            while time.monotonic() < sent + delay:
-                executor.spin_once(timeout_sec=0.002)
-            during = served and not future.done()
+            call = subprocess.Popen(
+                caller + ['call', request_path, '--service', namespace + '/plan_sequence',
+                          '--no-paths', '--timeout', str(CALL_TIMEOUT_SEC)],
+                env=env, stdout=call_log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
+            taken = served and _wait_for_text(log_path, b'plan_sequence #1:', call, 30.0)
+            time.sleep(delay)
+            during = taken and call.poll() is None
             process.send_signal(number)
-            deadline = time.monotonic() + STOP_TIMEOUT_SEC
-            while process.poll() is None and time.monotonic() < deadline:
-                executor.spin_once(timeout_sec=0.01)
-            if process.poll() is None:
+            try:
+                returncode: Optional[int] = process.wait(STOP_TIMEOUT_SEC)
+            except subprocess.TimeoutExpired:
                 process.kill()
                 process.wait()
                 returncode = None
-            else:
-                returncode = process.returncode
-            answered = future.done()
-            if not answered:
-                client.remove_pending_request(future)
+            call.wait(CALL_TIMEOUT_SEC + 30.0)
         finally:
-            if process.poll() is None:
-                process.kill()
-                process.wait()
+            for child in (process, call):
+                if child is not None and child.poll() is None:
+                    child.kill()
+                    child.wait()
             client_node.destroy_client(client)
     with open(log_path, 'rb') as stream:
         output = stream.read().decode('utf-8', 'replace')
+    with open(call_log_path, 'rb') as stream:
+        answered = b'# error_code' in stream.read()
     return Cycle(signal.Signals(number).name, k, delay, served, during, answered, returncode,
                  output)

@@ -24,11 +24,13 @@ the subscriptions. Not rclpy's MultiThreadedExecutor: in rclpy 7.1 it busy-
 loops on subscription traffic (ros2/rclpy#1223, #1452), and measured here, with
 obstacles and robot states at 50 Hz, service round trips went from 4 ms to 80
 ms median with stalls of 2-6 s (two single-threaded executors: 3.4 ms, worst 6
-ms). A plan is published only once it is complete. Start and stop (Ctrl-C and
+ms). A plan is answered first, then published, complete, after the reply
+(msg_docs/topics.md says in which order). Start and stop (Ctrl-C and
 SIGTERM alike, threads joined before anything is destroyed):
 :func:`punctured_planner.ros.runtime.run_nodes`.
 """
 
+from dataclasses import dataclass
 import sys
 import threading
 import traceback
@@ -56,6 +58,7 @@ from ..ros.runtime import run_nodes
 from ..ros.settings import PLANNER
 from ..ros.settings import PlannerSettings
 from ..ros.snapshot import ObstacleSet
+from ..ros.snapshot import Outcome
 from ..ros.snapshot import RobotOdometry
 from ..ros.snapshot import RobotState
 from ..ros.snapshot import Snapshot
@@ -66,6 +69,15 @@ from ..ros.wording import ObstacleNames
 SEND_TIMEOUT_WARNING = 'failed to send response (timeout)'
 # Attempts at sending one reply: up to 1 s for a new client's reader to be matched.
 SEND_ATTEMPTS = 10
+
+
+@dataclass(frozen=True)
+class AfterReply:
+    """A certified plan to publish once its reply is sent: request number, outcome, settings."""
+
+    number: int
+    outcome: Outcome
+    settings: PlannerSettings
 
 
 class PlannerNode(Node):
@@ -108,6 +120,7 @@ class PlannerNode(Node):
         self._send = self._service.send_response
         self._service.send_response = self._send_response
         self._answering = 0  # the number of the request whose reply is being sent
+        self._after_reply: AfterReply | None = None  # what to publish once it is sent
         s = self._settings
         self.get_logger().info(
             'serving %s: frame %s, dimension %d, variant %s, robot radius %g, %s, robots %s'
@@ -202,14 +215,8 @@ class PlannerNode(Node):
         if outcome.ok:
             self._plan_count += 1
             outcome.plan_id = response.plan_id = self._plan_count
-            try:
-                self._publish(outcome, snapshot.settings)
-            except Exception as error:  # never crash the service
-                logger.error('plan_sequence #%d: publishing failed: %r' % (number, error))
-                conversions.fill_error(response, PlanSequence.Response.UNKNOWN,
-                                       'internal error while publishing: %s' % error)
-                self._retract(outcome.names, snapshot.settings)
-                return response
+            # Published by _send_response once the reply is out (answer first).
+            self._after_reply = AfterReply(number, outcome, snapshot.settings)
             p = outcome.plan
             logger.info('plan_sequence #%d: planned k=%d n=%d, domain %d of %d, clearance '
                         '%.6g, %.3f ms' % (number, p.positions.shape[1],
@@ -235,6 +242,15 @@ class PlannerNode(Node):
         short window is shown again below, not lost.
         """
         number, sequence = self._answering, header.request_id.sequence_number
+        try:
+            self._send_attempts(response, header, number, sequence)
+        finally:
+            after, self._after_reply = self._after_reply, None
+            if after is not None:
+                self._publish_after_reply(after)
+
+    def _send_attempts(self, response, header, number, sequence):
+        """Send one reply, up to SEND_ATTEMPTS times while rmw reports the timeout."""
         for attempt in range(1, SEND_ATTEMPTS + 1):
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter('always')
@@ -254,16 +270,40 @@ class PlannerNode(Node):
                 % (number, response.error_code, sequence, attempt, SEND_ATTEMPTS,
                    failed[0].message))
 
+    def _publish_after_reply(self, after):
+        """
+        Publish an answered plan; a failure is logged and the robots' paths retracted.
+
+        The caller already holds a success with the plan id: the plan is then
+        not on ``plan``, so an ``execute_plan`` of it ends NO_PLAN (msg_docs/topics.md).
+        """
+        try:
+            self._publish(after.outcome, after.settings)
+        except Exception as error:  # never crash the service
+            self.get_logger().error(
+                'plan_sequence #%d: plan %d answered, but publishing it failed: %r; its '
+                'paths are retracted and it is not on plan' % (
+                    after.number, after.outcome.plan_id, error))
+            self._retract(after.outcome.names, after.settings)
+
     def _publish(self, outcome, settings):
-        """Publish the complete plan: every robot's Path, stale robots emptied, markers, index."""
+        """
+        Publish the complete plan in the order of msg_docs/topics.md.
+
+        Every robot's Path, robots no longer planned emptied, then markers,
+        domain index and Plan last: a subscriber to ``plan`` finds the paths out.
+        """
         messages = publications.plan_messages(outcome, settings)
         publishers = [self._publisher(m.topic, m.msg_type) for m in messages]
         stale = [name for name in self._latched_names if name not in set(outcome.names)]
-        for publisher, message in zip(publishers, messages):
+        paths = len(outcome.names)
+        for publisher, message in zip(publishers[:paths], messages[:paths]):
             publisher.publish(message.data)
         for name in stale:
             self._publisher(name + '/plan', Path).publish(
                 conversions.empty_path(settings.frame_id, outcome.start_ns))
+        for publisher, message in zip(publishers[paths:], messages[paths:]):
+            publisher.publish(message.data)
         self._latched_names = list(outcome.names)
 
     def _retract(self, names, settings):
@@ -272,7 +312,7 @@ class PlannerNode(Node):
             for name in names:
                 self._publisher(name + '/plan', Path).publish(
                     conversions.empty_path(settings.frame_id, self.get_clock().now().nanoseconds))
-        except Exception as error:  # the service answers UNKNOWN regardless
+        except Exception as error:  # the reply is out already
             self.get_logger().error('could not retract the partial plan: %r' % error)
 
     def _publisher(self, topic, msg_type):

@@ -41,12 +41,21 @@ hung now and then, and segfaulted about once in 26 stops. Here instead:
 3. On the signal: the stop flag is set and every executor woken; each thread
    finishes its callback in flight and returns; the threads are joined. Only
    then are the executors shut down, the group's ``before_teardown`` hook run
-   (the executor leaves its robots stopped), the nodes destroyed (in reverse
-   order) and the Context shut down. Every step between the stop and the
-   destruction lives in one place, :meth:`ExecutorThreads.close`, which
-   :func:`run_nodes` and the in-process tests share: a later "keep the
-   participant until the replies in flight are delivered, or a bounded grace
-   period passed" step goes there, after the hook and before the nodes go.
+   (the executor leaves its robots stopped), then the process lingers until
+   ``REPLY_GRACE_SEC`` after the last reply it wrote, and only then are the
+   nodes destroyed (in reverse order) and the Context shut down. Every step
+   between the stop and the destruction lives in one place,
+   :meth:`ExecutorThreads.close`, which :func:`run_nodes` and the in-process
+   tests share.
+
+The stop, in the order of doc/design.md section 16: (1) no new request or
+goal is taken (the threads leave their loop after the callback in flight);
+(2) the plan calls in flight finish and write their replies; (3) the
+participant stays until ``REPLY_GRACE_SEC`` after the last reply written (a
+service's response or an action server's), so that the DDS writer can still
+deliver or resend it to a client that only just matched; (4) teardown.
+rclpy offers no acknowledgement of a service reply, so the linger is a
+bounded time after the write, not an observed delivery.
 
 A callback that raises stops the process the same way, with the traceback
 logged and exit code 1. A callback still running ``timeout_sec`` after the
@@ -60,6 +69,7 @@ import os
 import signal
 import sys
 import threading
+import time
 import traceback
 from typing import Callable
 from typing import List
@@ -73,12 +83,19 @@ from rclpy.executors import ConditionReachedException
 from rclpy.executors import ExternalShutdownException
 from rclpy.executors import ShutdownException
 from rclpy.executors import SingleThreadedExecutor
+from rclpy.action import ActionServer
 from rclpy.node import Node
+from rclpy.service import Service
 from rclpy.signals import SignalHandlerOptions
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 # Seconds a callback in flight may take to finish after the stop signal.
 STOP_TIMEOUT_SEC = 30.0
+# Seconds the participant stays after the last reply it wrote (step 3 of the stop):
+# enough for a reliable DDS writer to resend to a reader that matched late.
+REPLY_GRACE_SEC = 1.0
+# What writes a reply when its callback runs: a service, an action server.
+REPLYING = (Service, ActionServer)
 EXIT_OK = 0
 EXIT_FAILED = 1
 EXIT_BAD_PARAMETERS = 2
@@ -170,6 +187,7 @@ class ExecutorThreads:
         self.failure: Optional[BaseException] = None
         self._on_failure = on_failure
         self._stopping = threading.Event()
+        self._last_reply: Optional[float] = None  # time.monotonic() after the last reply
         self._executors = []
         for node in self.nodes:
             executor = SingleThreadedExecutor(context=context)
@@ -190,11 +208,13 @@ class ExecutorThreads:
         try:
             while not self._stopping.is_set():
                 try:
-                    handler, _, _ = executor.wait_for_ready_callbacks(
+                    handler, entity, _ = executor.wait_for_ready_callbacks(
                         condition=self._stopping.is_set)
                 except (ConditionReachedException, ShutdownException):
                     break
                 handler()
+                if isinstance(entity, REPLYING):
+                    self._last_reply = time.monotonic()
                 handler.result()  # raises the callback's exception
         except ExternalShutdownException:
             pass  # the Context was shut down by someone else: nothing left to spin
@@ -229,17 +249,31 @@ class ExecutorThreads:
         return [node.get_fully_qualified_name()
                 for node, thread in zip(self.nodes, self._threads) if thread.is_alive()]
 
-    def close(self, timeout_sec: float = STOP_TIMEOUT_SEC,
-              before_teardown: Optional[Callable[[], None]] = None) -> bool:
-        """
-        stop(), run before_teardown, destroy the nodes in reverse order: the whole teardown.
+    def linger(self, grace_sec: float = REPLY_GRACE_SEC) -> float:
+        """Sleep until ``grace_sec`` after the last reply written, if any; return the sleep."""
+        if self._last_reply is None:
+            return 0.0
+        remaining = max(0.0, self._last_reply + grace_sec - time.monotonic())
+        time.sleep(remaining)
+        return remaining
 
-        Return False (and leave everything as it is) if stop() failed.
+    def close(self, timeout_sec: float = STOP_TIMEOUT_SEC,
+              before_teardown: Optional[Callable[[], None]] = None,
+              grace_sec: float = REPLY_GRACE_SEC) -> bool:
+        """
+        stop(), before_teardown, linger(grace_sec), destroy the nodes in reverse order.
+
+        The whole stop (module docstring). Return False (and leave everything
+        as it is) if stop() failed.
         """
         if not self.stop(timeout_sec):
             return False
         if before_teardown is not None:
             before_teardown()
+        lingered = self.linger(grace_sec)
+        if lingered > 0.0:
+            self.nodes[0].get_logger().debug(
+                'stopping: kept the participant %.3f s for the last reply' % lingered)
         for node in reversed(self.nodes):
             node.destroy_node()
         return True
