@@ -3,7 +3,7 @@ Closed loop over real DDS: planner_node, fleet_sim and plan_executor as processe
 
 Three disc robots, one at half speed, one with 100 ms command latency, 5%
 velocity noise. One run checks the refusals (no plan, a robot not heard,
-odometry in another frame), a full execution with a stale robot in the middle
+odometry in another frame), a goal that waits for its plan, a full execution with a stale robot in the middle
 (the clock holds, then resumes), the true gap, the arrival, a cancel, and
 Ctrl-C of the executor in the middle of a goal (exit 0, no traceback, robots
 stopped, the simulator serving on). The figures for 20 robots are in bench/.
@@ -221,9 +221,10 @@ def test_plan_to_motion_over_dds(graph):
     client.spin_until(lambda: False, 0.3)
     assert np.linalg.norm(graph.positions() - GOAL, axis=1).max() <= 0.02
 
-    # cancel: every robot is commanded zero at once and stops
-    graph.plan([START])
-    handle, feedback = graph.send(0)
+    # a goal sent before its plan waits for it (the planner answers before it publishes),
+    # then a cancel: every robot is commanded zero at once and stops
+    handle, feedback = graph.send(2)
+    assert graph.plan([START]).plan_id == 2
     assert client.spin_until(lambda: feedback and feedback[-1][1].plan_time > 1.0, 20)
     assert graph.speeds().max() > 0.1
     cancel = handle.cancel_goal_async()

@@ -10,7 +10,9 @@ geometry_msgs/Twist in the robot's body frame, rotated from the planning frame
 by its odometry orientation) and ``<robot>/reference_pose`` (PoseStamped at
 the shared clock, both modes).
 
-Goal life: the plan is looked up (``NO_PLAN``), its tolerance checked
+Goal life: the plan is looked up (``NO_PLAN`` once ``PLAN_WAIT_SEC`` passed
+without it: the planner answers before it publishes, so a goal may name a plan
+still on its way), its tolerance checked
 (``UNSAFE_PLAN``); the executor then waits up to ``discovery_timeout`` for
 fresh odometry of every robot (``UNKNOWN_ROBOTS``) in the plan's frame
 (``FRAME_MISMATCH``); then it runs until every robot has arrived (``NONE``),
@@ -59,6 +61,8 @@ from ..ros.settings import ExecutorSettings
 from ..ros.snapshot import RobotOdometry
 
 Result = ExecutePlan.Result
+# Seconds a goal waits for a plan it names that was not heard yet (msg_docs/topics.md).
+PLAN_WAIT_SEC = 2.0
 
 
 @dataclass
@@ -95,6 +99,7 @@ class PlanExecutor(Node):
         self._odometry: dict[str, RobotOdometry] = {}
         self._links: dict[str, RobotLink] = {}
         self._run: Run | None = None
+        self._plan_waits: list[tuple[int, Future]] = []  # (plan id, 0: any; heard)
         self.create_subscription(Plan, 'plan', self._on_plan, LATCHED)
         self._server = ActionServer(self, ExecutePlan, 'execute_plan', self._execute,
                                     goal_callback=lambda goal: GoalResponse.ACCEPT,
@@ -119,6 +124,9 @@ class PlanExecutor(Node):
             self.get_logger().error('plan %d ignored: %s' % (msg.plan_id, error))
             return
         self._plans.add(plan)
+        for plan_id, heard in self._plan_waits:
+            if plan_id in (0, plan.plan_id) and not heard.done():
+                heard.set_result(True)
         for name in plan.names:
             self._link(name)
         self.get_logger().info('plan %d: %d robots, %.3f s, min gap %.6g m, tolerance %.6g m'
@@ -158,6 +166,8 @@ class PlanExecutor(Node):
             self._stop_robots(previous.plan.names)
             self._finish(previous, Result.PREEMPTED, 'preempted by a newer goal')
         found = self._plans.lookup(goal.request.plan_id, self.resolve_topic_name('plan'))
+        if found.code == Result.NO_PLAN:
+            found = await self._wait_for_plan(goal.request.plan_id)
         if found.code == Result.NONE:
             run = Run(goal, found.plan, self.get_clock().now().nanoseconds)
             self._run = run
@@ -178,6 +188,20 @@ class PlanExecutor(Node):
         else:
             self.get_logger().warning(line)
         return result
+
+    async def _wait_for_plan(self, plan_id):
+        """Wait up to PLAN_WAIT_SEC for plan ``plan_id`` (0: any) on ``plan``; look it up."""
+        heard = Future()
+        entry = (plan_id, heard)
+        self._plan_waits.append(entry)
+        timer = self.create_timer(PLAN_WAIT_SEC,
+                                  lambda: heard.done() or heard.set_result(False))
+        try:
+            await heard
+        finally:
+            self.destroy_timer(timer)
+            self._plan_waits.remove(entry)
+        return self._plans.lookup(plan_id, self.resolve_topic_name('plan'))
 
     def _finish(self, run, code, message):
         """End a run with a result (once); the goal's coroutine resumes with it."""
