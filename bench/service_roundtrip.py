@@ -3,9 +3,9 @@ Service round trip of planner_node across processes, against the transport's flo
 
 Starts the installed ``planner_node`` console script in its own process (three
 obstacles, spread variant, no robot_count), discovers ``plan_sequence`` from
-this process and times complete calls: request out, plan, paths and markers
-built, the plan published on every robot's topic, the response back and
-deserialised here. Seeded random requests, n configurations of k robots.
+this process and times complete calls: request out, plan, paths built, the
+response back and deserialised here (the node publishes the plan after the
+response: msg_docs/topics.md). Seeded random requests, n configurations of k robots.
 
 The floor, measured in the same run: an echo server in a process of its own
 (this script with ``--echo-server``, spun the way the node is) answers the same
@@ -15,6 +15,7 @@ and DDS cost alone: the request taken and converted, the response converted,
 serialised, sent, deserialised here. Calls to the two alternate.
 
     .venv/bin/python bench/service_roundtrip.py                 # k = 8, n = 3
+    .venv/bin/python bench/service_roundtrip.py -k 8 512 --refine false  # transport only
     .venv/bin/python bench/service_roundtrip.py --sweep         # k in 2, 8, 64, 512, 2048
 
 Prints median and p90 round trip, the floor's median, ours / floor, the node's
@@ -52,10 +53,11 @@ def call(executor, client, request, timeout_sec=120.0):
     return call_service(executor, client, request, timeout_sec)
 
 
-def settings():
+def settings(refine):
     """Return the node's settings in this benchmark (as its -p parameters set them)."""
     from punctured_planner.ros.settings import PLANNER
-    return PLANNER.settings({'obstacles': OBSTACLES, 'max_poses': MAX_POSES})
+    return PLANNER.settings({'obstacles': OBSTACLES, 'max_poses': MAX_POSES,
+                             'refine': refine})
 
 
 def requests_for(k, n, calls, seed=1):
@@ -70,7 +72,7 @@ def _key(request):
     return len(poses), poses[0].position.x
 
 
-def echo_server(ks, n, calls):
+def echo_server(ks, n, calls, refine):
     """
     Serve ``echo_sequence``: for each request the benchmark sends, a prebuilt response.
 
@@ -87,7 +89,7 @@ def echo_server(ks, n, calls):
     prebuilt = {}
     for k in ks:
         for request in requests_for(k, n, calls or calls_for(k)):
-            outcome = offline_plan(request, settings())
+            outcome = offline_plan(request, settings(refine))
             assert outcome.ok, outcome.response.error_msg
             prebuilt[_key(request)] = outcome.response
 
@@ -136,23 +138,29 @@ def main(argv=None):
     """Run the benchmark; print one line per k."""
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--sweep', action='store_true', help='k in %s' % (SWEEP,))
-    parser.add_argument('-k', type=int, default=8, help='robots (default: %(default)s)')
+    parser.add_argument('-k', type=int, nargs='+', default=[8],
+                        help='robots, one or more (default: 8)')
     parser.add_argument('-n', type=int, default=3, help='configurations (default: 3)')
     parser.add_argument('--calls', type=int, default=None, help='timed calls per k')
+    parser.add_argument('--refine', choices=('true', 'false'), default='true',
+                        help="the node's refine parameter (false: no refinement, so that "
+                        'its compute time is not counted as transport)')
     parser.add_argument('--echo-server', action='store_true',
                         help='serve the floor (started by this script itself)')
     args, _ = parser.parse_known_args(argv)
-    ks = SWEEP if args.sweep else (args.k,)
+    ks = SWEEP if args.sweep else tuple(args.k)
+    refine = args.refine == 'true'
     if args.echo_server:
-        return echo_server(ks, args.n, args.calls)
+        return echo_server(ks, args.n, args.calls, refine)
     parameters = {'obstacles': '[%s]' % ','.join(str(v) for v in OBSTACLES),
-                  'max_poses': MAX_POSES}
+                  'max_poses': MAX_POSES, 'refine': args.refine}
     with planner_session('bench', parameters) as session:
         from punctured_planner_interfaces.srv import PlanSequence
         echo_process = subprocess.Popen(
             [sys.executable, __file__, '--echo-server', '-n', str(args.n)]
             + (['--calls', str(args.calls)] if args.calls else [])
-            + (['--sweep'] if args.sweep else ['-k', str(args.k)])
+            + (['--sweep'] if args.sweep else ['-k'] + [str(k) for k in ks])
+            + ['--refine', args.refine]
             + ['--ros-args', '-r', '__ns:=' + session.namespace + '_echo'],
             stdout=subprocess.DEVNULL, stdin=subprocess.DEVNULL)
         try:
@@ -169,8 +177,8 @@ def main(argv=None):
                   '%.2f s (ROS_DOMAIN_ID %s, %s)'
                   % (time.perf_counter() - started, os.environ['ROS_DOMAIN_ID'],
                      os.environ.get('RMW_IMPLEMENTATION', 'default RMW')))
-            print('n = %d configurations, 3 obstacles, spread variant, samples_per_leg 0'
-                  % args.n)
+            print('n = %d configurations, 3 obstacles, spread variant, samples_per_leg 0, '
+                  'refine %s' % (args.n, args.refine))
             print('%6s %6s %10s %10s %10s %10s %12s %12s'
                   % ('k', 'calls', 'median ms', 'p90 ms', 'floor ms', 'ours/floor',
                      'planning ms', 'bytes'))

@@ -3,10 +3,11 @@ Closed loop over real DDS: planner_node, fleet_sim and plan_executor as processe
 
 Three disc robots, one at half speed, one with 100 ms command latency, 5%
 velocity noise. One run checks the refusals (no plan, a robot not heard,
-odometry in another frame), a goal that waits for its plan, a full execution with a stale robot in the middle
-(the clock holds, then resumes), the true gap, the arrival, a cancel, and
-Ctrl-C of the executor in the middle of a goal (exit 0, no traceback, robots
-stopped, the simulator serving on). The figures for 20 robots are in bench/.
+odometry in another frame), a goal that waits for its plan, a full execution
+with a stale robot in the middle (the clock holds, then resumes), the true gap,
+the arrival, a cancel, and Ctrl-C of the executor in the middle of a goal (the
+goal ends STOPPED, exit 0, no traceback, robots stopped, the simulator serving
+on). The figures for 20 robots are in bench/.
 """
 
 import signal
@@ -243,7 +244,11 @@ def test_plan_to_motion_over_dds(graph):
     handle, feedback = graph.send(0)
     assert client.spin_until(lambda: feedback and feedback[-1][1].plan_time > 0.5, 20)
     executor = graph.processes['plan_executor']
+    stopped = handle.get_result_async()
     executor.proc.send_signal(signal.SIGINT)
+    # the goal ends with a code of its own, its result out before the node goes
+    assert client.spin_until(stopped.done, 10), executor.log()
+    assert stopped.result().result.error_code == result_type.STOPPED, executor.log()
     assert executor.proc.wait(timeout=10) == 0, executor.log()
     client.spin_until(lambda: False, 0.5)
     assert graph.speeds().max() < 1e-9

@@ -21,8 +21,10 @@ callback itself, without waiting for the next tick), a newer goal
 (``PREEMPTED``) or odometry in another frame (``FRAME_MISMATCH``). Stale
 odometry never ends a goal: the clock holds until the robot is back.
 Everything runs on one single-threaded executor, so callbacks never overlap.
-On Ctrl-C or SIGTERM the runtime's ``before_teardown`` hook sends zero
-velocity to the robots of the active goal before the node goes.
+On Ctrl-C or SIGTERM new goals are rejected, the active goal's robots are
+sent zero velocity and the goal aborts with ``STOPPED`` (the runtime's
+``before_stop`` hook, while the node still spins); ``before_teardown`` sends
+zero velocity once more before the node goes.
 """
 
 from dataclasses import dataclass
@@ -77,6 +79,7 @@ class Run:
     started_ns: int = 0
     last_ns: int = 0
     stale: tuple = ()
+    ended: Future = field(default_factory=Future)  # done once the goal's result is out
 
 
 @dataclass(frozen=True)
@@ -100,9 +103,11 @@ class PlanExecutor(Node):
         self._links: dict[str, RobotLink] = {}
         self._run: Run | None = None
         self._plan_waits: list[tuple[int, Future]] = []  # (plan id, 0: any; heard)
+        self._stopping = False  # the process is stopping: no new goal
+        self._halted: tuple = ()  # the robots of the goal ended by the stop
         self.create_subscription(Plan, 'plan', self._on_plan, LATCHED)
         self._server = ActionServer(self, ExecutePlan, 'execute_plan', self._execute,
-                                    goal_callback=lambda goal: GoalResponse.ACCEPT,
+                                    goal_callback=self._on_goal,
                                     cancel_callback=self._on_cancel)
         self._timer = self.create_timer(1.0 / self._settings.control_rate, self._control)
         self.get_logger().info('serving %s, mode %s, control at %g Hz'
@@ -150,6 +155,10 @@ class PlanExecutor(Node):
 
     # ------------------------------------------------------------ the action
 
+    def _on_goal(self, goal):
+        """Accept every goal, unless the process is stopping."""
+        return GoalResponse.REJECT if self._stopping else GoalResponse.ACCEPT
+
     def _on_cancel(self, goal):
         """Accept a cancel of the active goal and stop every robot at once."""
         run = self._run
@@ -168,6 +177,7 @@ class PlanExecutor(Node):
         found = self._plans.lookup(goal.request.plan_id, self.resolve_topic_name('plan'))
         if found.code == Result.NO_PLAN:
             found = await self._wait_for_plan(goal.request.plan_id)
+        run = None
         if found.code == Result.NONE:
             run = Run(goal, found.plan, self.get_clock().now().nanoseconds)
             self._run = run
@@ -187,6 +197,9 @@ class PlanExecutor(Node):
             self.get_logger().info(line)
         else:
             self.get_logger().warning(line)
+        if run is not None:
+            # The action server sends the result as this coroutine returns, in the same step.
+            run.ended.set_result(True)
         return result
 
     async def _wait_for_plan(self, plan_id):
@@ -305,17 +318,33 @@ class PlanExecutor(Node):
         for name in names:
             self._links[name].cmd_vel.publish(conversions.twist())
 
-    def stop_active_robots(self):
-        """Stop the robots of the active goal (the runtime's before_teardown hook)."""
+    def end_goals(self) -> Future | None:
+        """
+        Refuse new goals; stop the active goal's robots, end it STOPPED (runtime before_stop).
+
+        Return the Future that is done once its result is out, None without a goal.
+        """
+        self._stopping = True
         run = self._run
-        if run is not None:
-            self._stop_robots(run.plan.names)
+        if run is None:
+            return None
+        self._halted = run.plan.names
+        self._stop_robots(run.plan.names)
+        self._finish(run, Result.STOPPED, 'plan_executor stopped at plan time %.3f s; its '
+                     'robots were sent zero velocity'
+                     % (run.execution.plan_time if run.execution else 0.0))
+        return run.ended
+
+    def stop_halted_robots(self):
+        """Send zero velocity again to the robots end_goals stopped: the last command they get."""
+        self._stop_robots(self._halted)
 
 
 def executor_nodes(context=None, **kwargs) -> NodeGroup:
-    """Return the executor, whose robots are stopped before it is destroyed."""
+    """Return the executor: at a stop its goal ends STOPPED, its robots stopped."""
     node = PlanExecutor(context=context, **kwargs)
-    return NodeGroup([node], before_teardown=node.stop_active_robots)
+    return NodeGroup([node], before_stop=node.end_goals,
+                     before_teardown=node.stop_halted_robots)
 
 
 def main(args=None):

@@ -49,8 +49,12 @@ hung now and then, and segfaulted about once in 26 stops. Here instead:
    tests share.
 
 The stop, in the order of doc/design.md section 16: (1) no new request or
-goal is taken (the threads leave their loop after the callback in flight);
-(2) the plan calls in flight finish and write their replies; (3) the
+goal is taken (the threads leave their loop after the callback in flight;
+the group's ``before_stop`` hook, run in the first node's thread, makes its
+node refuse goals and end the one in flight); (2) the plan calls in flight
+finish and write their replies, and the thread with the hook spins on until
+the Future it returned is done (a goal's result sent), at most
+``STOP_DRAIN_SEC``; (3) the
 participant stays until ``REPLY_GRACE_SEC`` after the last reply written (a
 service's response or an action server's), so that the DDS writer can still
 deliver or resend it to a client that only just matched; (4) teardown.
@@ -83,10 +87,12 @@ from rclpy.executors import ConditionReachedException
 from rclpy.executors import ExternalShutdownException
 from rclpy.executors import ShutdownException
 from rclpy.executors import SingleThreadedExecutor
+from rclpy.executors import TimeoutException
 from rclpy.action import ActionServer
 from rclpy.node import Node
 from rclpy.service import Service
 from rclpy.signals import SignalHandlerOptions
+from rclpy.task import Future
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 # Seconds a callback in flight may take to finish after the stop signal.
@@ -94,6 +100,8 @@ STOP_TIMEOUT_SEC = 30.0
 # Seconds the participant stays after the last reply it wrote (step 3 of the stop):
 # enough for a reliable DDS writer to resend to a reader that matched late.
 REPLY_GRACE_SEC = 1.0
+# Seconds the first node's thread spins on after the stop for before_stop's Future.
+STOP_DRAIN_SEC = 2.0
 # What writes a reply when its callback runs: a service, an action server.
 REPLYING = (Service, ActionServer)
 EXIT_OK = 0
@@ -163,11 +171,14 @@ class NodeGroup:
     """
     The nodes of one process and what must happen before they are destroyed.
 
-    ``before_teardown`` runs once the executors stopped and before any node
-    is destroyed: publishers still work, no callback runs any more.
+    ``before_stop`` runs in the first node's thread when the stop begins; it
+    returns a Future (or None) that the thread spins on for, such as a goal's
+    result going out. ``before_teardown`` runs once the executors stopped and
+    before any node is destroyed: publishers still work, no callback runs any more.
     """
 
     nodes: Sequence[Node]
+    before_stop: Optional[Callable[[], Optional[Future]]] = None
     before_teardown: Optional[Callable[[], None]] = None
 
 
@@ -177,15 +188,18 @@ class ExecutorThreads:
 
     ``start()`` once, then ``close()`` (or ``stop()`` and destroy the nodes
     yourself). ``on_failure`` is called from the thread of a callback that
-    raised; the exception is in :attr:`failure` and the logs.
+    raised; the exception is in :attr:`failure` and the logs. ``before_stop``
+    is :attr:`NodeGroup.before_stop`.
     """
 
     def __init__(self, nodes: Sequence[Node], context: Optional[Context] = None,
-                 on_failure: Optional[Callable[[], None]] = None):
+                 on_failure: Optional[Callable[[], None]] = None,
+                 before_stop: Optional[Callable[[], Optional[Future]]] = None):
         """Make one executor per node (in ``context``); nothing spins yet."""
         self.nodes: List[Node] = list(nodes)
         self.failure: Optional[BaseException] = None
         self._on_failure = on_failure
+        self._before_stop = before_stop
         self._stopping = threading.Event()
         self._last_reply: Optional[float] = None  # time.monotonic() after the last reply
         self._executors = []
@@ -194,28 +208,22 @@ class ExecutorThreads:
             executor.add_node(node)
             self._executors.append(executor)
         self._threads = [
-            threading.Thread(target=self._spin, args=(node, executor),
+            threading.Thread(target=self._spin, args=(node, executor, index == 0),
                              name='spin ' + node.get_fully_qualified_name())
-            for node, executor in zip(self.nodes, self._executors)]
+            for index, (node, executor) in enumerate(zip(self.nodes, self._executors))]
 
     def start(self) -> None:
         """Start spinning every node in its thread."""
         for thread in self._threads:
             thread.start()
 
-    def _spin(self, node: Node, executor: SingleThreadedExecutor) -> None:
+    def _spin(self, node: Node, executor: SingleThreadedExecutor, first: bool) -> None:
         """Run callbacks until stop(); a callback's exception ends the loop (and is logged)."""
         try:
-            while not self._stopping.is_set():
-                try:
-                    handler, entity, _ = executor.wait_for_ready_callbacks(
-                        condition=self._stopping.is_set)
-                except (ConditionReachedException, ShutdownException):
-                    break
-                handler()
-                if isinstance(entity, REPLYING):
-                    self._last_reply = time.monotonic()
-                handler.result()  # raises the callback's exception
+            while self._run_one(executor, self._stopping.is_set):
+                pass
+            if first and self._before_stop is not None:
+                self._drain(executor, self._before_stop())
         except ExternalShutdownException:
             pass  # the Context was shut down by someone else: nothing left to spin
         except BaseException as error:  # noqa: B902 - logged, then the process stops
@@ -224,6 +232,31 @@ class ExecutorThreads:
                 traceback.format_exception(error)))
             if self._on_failure is not None:
                 self._on_failure()
+
+    def _run_one(self, executor: SingleThreadedExecutor, condition: Callable[[], bool],
+                 timeout_sec: Optional[float] = None) -> bool:
+        """Run one ready callback; return False once ``condition()`` or the timeout came."""
+        try:
+            handler, entity, _ = executor.wait_for_ready_callbacks(
+                timeout_sec=timeout_sec, condition=condition)
+        except (ConditionReachedException, ShutdownException, TimeoutException):
+            return False
+        handler()
+        if isinstance(entity, REPLYING):
+            self._last_reply = time.monotonic()
+        handler.result()  # raises the callback's exception
+        return not condition()
+
+    def _drain(self, executor: SingleThreadedExecutor, ended: Optional[Future]) -> None:
+        """Spin on until ``ended`` is done or STOP_DRAIN_SEC passed; a reply went out then."""
+        if ended is None:
+            return
+        deadline = time.monotonic() + STOP_DRAIN_SEC
+        while not ended.done():
+            remaining = deadline - time.monotonic()
+            if remaining <= 0.0 or not self._run_one(executor, ended.done, remaining):
+                break
+        self._last_reply = time.monotonic()
 
     def stop(self, timeout_sec: float = STOP_TIMEOUT_SEC) -> bool:
         """
@@ -300,7 +333,8 @@ def run_nodes(name: str, make_nodes: Callable[[Context], NodeGroup],
             except BAD_PARAMETERS as error:
                 print('%s: invalid parameters: %s' % (name, error), file=sys.stderr)
                 return EXIT_BAD_PARAMETERS
-            threads = ExecutorThreads(group.nodes, context, on_failure=signals.wake)
+            threads = ExecutorThreads(group.nodes, context, on_failure=signals.wake,
+                                      before_stop=group.before_stop)
             threads.start()
             signals.wait()
             _teardown(threads, group, timeout_sec)
