@@ -5,10 +5,10 @@ For each install (the venv's console script; the colcon install built from a
 copy of this checkout with the README's command), ``--cycles`` times: start
 planner_node, wait for its service, send one call (k = 8 or 512 robots, n = 3) from a
 fresh ``punctured-planner call`` process, send SIGINT or SIGTERM a random 0-0.3 s
-after the node took the call (during or after the plan), wait for the exit. Counts non-zero exits, tracebacks, segfaults and
-hangs (no exit within 40 s), how many signals landed during a call and how many of those calls got their
-reply.
-Seeded; the logs of unclean cycles are kept. ``make test`` runs a few of the
+after the node took the call (during or after the plan), wait for the exit.
+Counts non-zero exits, tracebacks, segfaults and hangs (no exit within 40 s),
+how many signals landed during a call and how many of those calls got their
+reply. Seeded; the logs of unclean cycles are kept. ``make test`` runs a few of the
 same cycles (test/test_clean_stop.py, test/test_colcon_build.py).
 
     .venv/bin/python bench/stop_stress.py                        # 300 per install

@@ -81,6 +81,7 @@ from typing import Optional
 from typing import Sequence
 
 import rclpy
+from rclpy.action import ActionServer
 from rclpy.context import Context
 from rclpy.exceptions import ParameterException
 from rclpy.executors import ConditionReachedException
@@ -88,7 +89,6 @@ from rclpy.executors import ExternalShutdownException
 from rclpy.executors import ShutdownException
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.executors import TimeoutException
-from rclpy.action import ActionServer
 from rclpy.node import Node
 from rclpy.service import Service
 from rclpy.signals import SignalHandlerOptions
@@ -236,6 +236,7 @@ class ExecutorThreads:
     def _run_one(self, executor: SingleThreadedExecutor, condition: Callable[[], bool],
                  timeout_sec: Optional[float] = None) -> bool:
         """Run one ready callback; return False once ``condition()`` or the timeout came."""
+        entity: object  # what the callback belongs to: a Service, a Timer, a waitable...
         try:
             handler, entity, _ = executor.wait_for_ready_callbacks(
                 timeout_sec=timeout_sec, condition=condition)
