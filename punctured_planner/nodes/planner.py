@@ -24,8 +24,8 @@ the subscriptions. Not rclpy's MultiThreadedExecutor: in rclpy 7.1 it busy-
 loops on subscription traffic (ros2/rclpy#1223, #1452), and measured here, with
 obstacles and robot states at 50 Hz, service round trips went from 4 ms to 80
 ms median with stalls of 2-6 s (two single-threaded executors: 3.4 ms, worst 6
-ms). A plan is answered first, then published, complete, after the reply
-(msg_docs/topics.md says in which order). Start and stop (Ctrl-C and
+ms). A plan is answered first; then it is published, complete, in the order
+msg_docs/topics.md gives. Start and stop (Ctrl-C and
 SIGTERM alike, threads joined before anything is destroyed):
 :func:`punctured_planner.ros.runtime.run_nodes`.
 """
