@@ -49,7 +49,8 @@ hung now and then, and segfaulted about once in 26 stops. Here instead:
    tests share.
 
 The stop, in the order of doc/design.md section 16: (1) no new request or
-goal is taken (the threads leave their loop after the callback in flight;
+goal is taken (the threads leave their loop after the callback in flight,
+then answer the service requests that had already arrived;
 the group's ``before_stop`` hook, run in the first node's thread, makes its
 node refuse goals and end the one in flight); (2) the plan calls in flight
 finish and write their replies, and the thread with the hook spins on until
@@ -75,6 +76,7 @@ import sys
 import threading
 import time
 import traceback
+from typing import Any
 from typing import Callable
 from typing import List
 from typing import Optional
@@ -93,6 +95,8 @@ from rclpy.node import Node
 from rclpy.service import Service
 from rclpy.signals import SignalHandlerOptions
 from rclpy.task import Future
+
+from .qos import SERVER_QOS
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 # Seconds a callback in flight may take to finish after the stop signal.
@@ -162,6 +166,11 @@ class StopSignals:
             pass  # the pipe is full of wake-ups already
 
 
+def _never() -> bool:
+    """Return False: a condition that never ends a wait."""
+    return False
+
+
 def _ignore(number, frame):
     """Signal handler: nothing to do, the wake-up fd has woken StopSignals.wait."""
 
@@ -222,6 +231,7 @@ class ExecutorThreads:
         try:
             while self._run_one(executor, self._stopping.is_set):
                 pass
+            self._answer_waiting(node)
             if first and self._before_stop is not None:
                 self._drain(executor, self._before_stop())
         except ExternalShutdownException:
@@ -248,6 +258,24 @@ class ExecutorThreads:
         handler.result()  # raises the callback's exception
         return not condition()
 
+    def _answer_waiting(self, node: Node) -> None:
+        """
+        Answer the requests that reached the node's services before the stop (step 2).
+
+        A request the executor had not taken yet when the signal came is in flight
+        for its client too: it is taken and answered here, in this thread, as the
+        executor would (at most the server's queue depth per service).
+        """
+        for service in node.services:
+            srv_type: Any = service.srv_type  # a generated type: Request, Response
+            for _ in range(SERVER_QOS.depth):
+                with service.handle:
+                    request, header = service.handle.service_take_request(srv_type.Request)
+                if header is None:
+                    break
+                service.send_response(service.callback(request, srv_type.Response()), header)
+                self._last_reply = time.monotonic()
+
     def _drain(self, executor: SingleThreadedExecutor, ended: Optional[Future]) -> None:
         """Spin on until ``ended`` is done or STOP_DRAIN_SEC passed; a reply went out then."""
         if ended is None:
@@ -257,6 +285,10 @@ class ExecutorThreads:
             remaining = deadline - time.monotonic()
             if remaining <= 0.0 or not self._run_one(executor, ended.done, remaining):
                 break
+        # What ``ended`` set off (an action server sends the result in a task of its
+        # own): run whatever is ready now, until nothing is.
+        while time.monotonic() < deadline and self._run_one(executor, _never, 0.0):
+            pass
         self._last_reply = time.monotonic()
 
     def stop(self, timeout_sec: float = STOP_TIMEOUT_SEC) -> bool:
