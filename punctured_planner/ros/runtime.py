@@ -41,26 +41,25 @@ hung now and then, and segfaulted about once in 26 stops. Here instead:
 3. On the signal: the stop flag is set and every executor woken; each thread
    finishes its callback in flight and returns; the threads are joined. Only
    then are the executors shut down, the group's ``before_teardown`` hook run
-   (the executor leaves its robots stopped), then the process lingers until
+   (plan_executor's last zero velocity), then the process lingers until
    ``REPLY_GRACE_SEC`` after the last reply it wrote, and only then are the
    nodes destroyed (in reverse order) and the Context shut down. Every step
    between the stop and the destruction lives in one place,
    :meth:`ExecutorThreads.close`, which :func:`run_nodes` and the in-process
    tests share.
 
-The stop, in the order of doc/design.md section 16: (1) no new request or
-goal is taken (the threads leave their loop after the callback in flight,
-then answer the service requests that had already arrived;
-the group's ``before_stop`` hook, run in the first node's thread, makes its
-node refuse goals and end the one in flight); (2) the plan calls in flight
-finish and write their replies, and the thread with the hook spins on until
-the Future it returned is done (a goal's result sent), at most
-``STOP_DRAIN_SEC``; (3) the
-participant stays until ``REPLY_GRACE_SEC`` after the last reply written (a
-service's response or an action server's), so that the DDS writer can still
-deliver or resend it to a client that only just matched; (4) teardown.
-rclpy offers no acknowledgement of a service reply, so the linger is a
-bounded time after the write, not an observed delivery.
+The stop, in the order of doc/design.md section 16: (1) no new work: the
+threads leave their loop after the callback in flight, and the group's
+``before_stop`` hook (run in the first node's thread) makes its node refuse
+goals; (2) what is in flight finishes: the plan call in flight writes its
+reply, each thread answers the service requests that had already arrived,
+and the hook ends the goal in flight while its thread spins on until the
+Future it returned is done (the result sent), at most ``STOP_DRAIN_SEC``;
+(3) the participant stays until ``REPLY_GRACE_SEC`` after the last reply
+written (a service's response or an action server's), so that the DDS writer
+can still deliver or resend it to a client that only just matched; (4)
+teardown. rclpy offers no acknowledgement of a service reply, so the linger
+is a bounded time after the write, not an observed delivery.
 
 A callback that raises stops the process the same way, with the traceback
 logged and exit code 1. A callback still running ``timeout_sec`` after the
