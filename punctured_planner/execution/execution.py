@@ -58,10 +58,15 @@ class ExecutionSettings:
 
     def differential(self, robot_count: int) -> np.ndarray:
         """Return the (k,) mask of differential robots; ValueError if drive does not fit k."""
-        if len(self.drive) not in (1, robot_count):
-            raise ValueError('drive has %d values for %d robots (one, or one per robot)'
-                             % (len(self.drive), robot_count))
-        return np.broadcast_to(np.asarray(self.drive) == DIFFERENTIAL, robot_count).copy()
+        return differential_mask(self.drive, robot_count)
+
+
+def differential_mask(drive: tuple, robot_count: int) -> np.ndarray:
+    """Return the (k,) mask of drive's differential robots (one value, or one per robot)."""
+    if len(drive) not in (1, robot_count):
+        raise ValueError('drive has %d values for %d robots (one, or one per robot)'
+                         % (len(drive), robot_count))
+    return np.broadcast_to(np.asarray(drive) == DIFFERENTIAL, robot_count).copy()
 
 
 @dataclass(frozen=True)

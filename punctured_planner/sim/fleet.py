@@ -132,7 +132,8 @@ class Fleet:
         self._ramped = np.where(limits > 0, self._ramped + np.clip(change, -limits, limits),
                                 wanted)
         noise = 1.0 + s.velocity_noise * self._rng.standard_normal((len(wanted), 2))
-        forward, yaw_rate = (self.speed_factors[:, None] * self._ramped * noise).T
+        executed = np.where(self.differential[:, None], self._ramped, 0.0)
+        forward, yaw_rate = (self.speed_factors[:, None] * executed * noise).T
         turned = yaw_rate * dt
         # the exact arc: the chord has length 2 v sin(w dt / 2) / w, along the mid heading
         chord = forward * dt * np.sinc(turned / (2.0 * np.pi))
