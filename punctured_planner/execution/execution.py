@@ -108,9 +108,12 @@ class Execution:
         self.differential = settings.differential(reference.robot_count)
         self.lead = unicycle.lead(self.tolerance, settings.slow_fraction,
                                   settings.hold_fraction)
+        self.steering = unicycle.steering(self.lead)
         self.corners = unicycle.Corners(reference.seconds, reference.positions)
         self.final_yaws = unicycle.yaws(reference.orientation(reference.duration))
         self.turning = np.zeros(reference.robot_count, dtype=bool)
+        # robots driving backward: their lead point is e behind, their 'heading' theta + pi
+        self.reverse = np.zeros(reference.robot_count, dtype=bool)
         self.settled = 0.0     # seconds every final heading has been reached for
 
     def step(self, dt: float, positions: np.ndarray, stale: np.ndarray,
@@ -134,11 +137,12 @@ class Execution:
             self.min_gap = min(self.min_gap, self.bodies.smallest_gap(positions).value)
         differential = self.differential & ~stale
         # the clock watches each differential robot's bound E of its centre error
-        lead_points = unicycle.lead_points(positions, angles, self.lead)
+        lead_points = unicycle.lead_points(positions, self._driving(angles), self.lead)
         watched = np.where(differential, np.linalg.norm(reference_now - lead_points, axis=1)
                            + self.lead, errors)
         dt = min(max(dt, 0.0), MAX_STEP)
         alpha = self._update_turns(angles, watched)
+        driving = self._driving(angles)
         if not s.shared_clock:
             rate = 1.0
         elif stale.any():
@@ -151,7 +155,7 @@ class Execution:
         target = self.reference.position(self.plan_time)
         command = rate * self.reference.velocity(self.plan_time) + s.gain * (target - positions)
         velocities = saturate(command, s.speed_limit)
-        unicycle_command = self._unicycle(rate, target, positions, angles, lead_points, alpha)
+        unicycle_command = self._unicycle(rate, target, positions, angles, driving, alpha)
         forward = np.where(differential, unicycle_command.forward, 0.0)
         yaw_rates = np.where(differential, unicycle_command.yaw_rate, 0.0)
         velocities = np.where(differential[:, None],
@@ -176,20 +180,31 @@ class Execution:
         """
         Start and end the differential robots' turns in place; return their misalignments.
 
-        A turn starts where the heading is more than TURN_ANGLE from the
-        direction the reference moves in (or moves next) and E <= hold
+        A turn starts where the driving heading is more than TURN_ANGLE from
+        the direction the reference moves in (or moves next) and E <= hold
         delta - 2e, so that E stays below hold delta (it grows by at most 2e
         while the centre stands); it ends within ALIGNED of that direction.
+        Where driving the other way round needs less turning, the robot
+        switches direction first: its lead point jumps by at most 2e, the same
+        bound.
         """
         s = self.settings
         directions, _ = self.corners.upcoming(self.plan_time)
-        alpha = unicycle.misalignment(angles, directions)
-        start = ((np.abs(alpha) > unicycle.TURN_ANGLE)
-                 & (watched <= s.hold_fraction * self.tolerance - 2.0 * self.lead))
+        alpha = unicycle.misalignment(self._driving(angles), directions)
+        may_turn = watched <= s.hold_fraction * self.tolerance - 2.0 * self.lead
+        flip = (self.differential & may_turn & (np.abs(alpha) > unicycle.TURN_ANGLE)
+                & (np.abs(unicycle.wrap(alpha + np.pi)) < np.abs(alpha)))
+        self.reverse ^= flip
+        alpha = np.where(flip, unicycle.wrap(alpha + np.pi), alpha)
+        start = (np.abs(alpha) > unicycle.TURN_ANGLE) & may_turn
         self.turning = (self.differential & (self.turning | start)
                         & (np.abs(alpha) > unicycle.ALIGNED)
                         & (self.plan_time < self.reference.duration))
         return alpha
+
+    def _driving(self, angles: np.ndarray) -> np.ndarray:
+        """Return the driving headings: the yaw, or yaw + pi for robots driving backward."""
+        return angles + np.pi * self.reverse
 
     def _differential_cap(self, alpha: np.ndarray, dt: float) -> float:
         """
@@ -207,14 +222,18 @@ class Execution:
         limit = settings.yaw_rate_limit
         room = np.clip((still_until - s_now) / dt, 0.0, 1.0) if dt > 0 else np.ones(len(alpha))
         caps = np.where(self.turning, room,
-                        unicycle.creep_rate(alpha, speeds, self.lead, limit))
-        caps = np.minimum(caps, self.corners.corner_caps(s_now, self.lead, limit))
+                        unicycle.creep_rate(alpha, speeds, self.steering, limit))
+        caps = np.minimum(caps, self.corners.corner_caps(s_now, self.steering, limit))
         return float(np.min(caps[self.differential], initial=1.0))
 
     def _unicycle(self, rate: float, target: np.ndarray, positions: np.ndarray,
-                  angles: np.ndarray, lead_points: np.ndarray,
+                  angles: np.ndarray, driving: np.ndarray,
                   alpha: np.ndarray) -> unicycle.UnicycleCommand:
-        """Return every robot's unicycle command: follow, turn, park or face the final pose."""
+        """
+        Return every robot's unicycle command: follow, turn, park or face the final pose.
+
+        angles are the yaws, driving the driving headings (yaw + pi backward).
+        """
         s = self.settings
         if self.plan_time >= self.reference.duration:
             command = unicycle.park(positions, angles, target, s.gain, s.speed_limit,
@@ -224,9 +243,12 @@ class Execution:
                      if s.final_heading else np.zeros(len(angles)))
             return unicycle.UnicycleCommand(np.where(parked, 0.0, command.forward),
                                             np.where(parked, final, command.yaw_rate))
+        lead_points = unicycle.lead_points(positions, driving, self.lead)
         desired = rate * self.reference.velocity(self.plan_time) + s.gain * (target
                                                                              - lead_points)
-        command = unicycle.follow(desired, angles, self.lead, s.speed_limit, s.yaw_rate_limit)
+        command = unicycle.follow(desired, driving, self.steering, s.speed_limit,
+                                  s.yaw_rate_limit)
+        forward = np.where(self.reverse, -command.forward, command.forward)
         return unicycle.UnicycleCommand(
-            np.where(self.turning, 0.0, command.forward),
+            np.where(self.turning, 0.0, forward),
             np.where(self.turning, unicycle.turn(alpha, s.yaw_rate_limit), command.yaw_rate))

@@ -4,14 +4,17 @@ Differential-drive robots: the tracking law on a point ahead, turns in place, th
 A differential (unicycle) robot with centre c and heading theta moves by
 c' = v h, theta' = omega, h = (cos theta, sin theta): it takes only a forward
 speed v and a yaw rate omega. The law (doc/design.md section 13) tracks the
-point P = c + e h a lead e ahead of the centre: P' = v h + e omega h_perp, so
-(v, omega) = (u . h, u . h_perp / e) gives P' = u exactly, and scaling both by
-one factor lambda <= 1 to meet the speed and yaw-rate limits gives
-P' = lambda u: the direction of P's velocity is kept. With
-u = rate x reference' + gain x (reference - P), the clock held (rate 0) makes
-P' = lambda gain (reference - P): the error of P never grows. The centre is
-within e of P, so the clock watches E = |reference - P| + e, an upper bound of
-the centre's error that never grows while the clock holds.
+point P = c + e h a lead e ahead of the centre: P' = v h + e omega h_perp.
+(v, omega) = (u . h, u . h_perp / l), with a steering length l >= e, both
+scaled by one factor lambda <= 1 to meet the speed and yaw-rate limits, give
+P' = lambda D u, D = h h^T + (e / l) h_perp h_perp^T positive definite: P
+moves within 90 degrees of u. With u = rate x reference' + gain x (reference - P),
+the clock held (rate 0) gives d|reference - P|^2/dt = -2 lambda gain
+(reference - P)^T D (reference - P) <= 0: the error of P never grows. The
+centre is within e of P, so the clock watches E = |reference - P| + e, an upper
+bound of the centre's error that never grows while the clock holds. l = e
+would be exact feedback linearisation, but the heading would then answer
+within e / v seconds, far faster than a base's command latency: it weaves.
 
 Where following would need a yaw rate beyond the limit (a corner, the start
 facing away), the robot turns in place (v = 0: the centre does not move) while
@@ -29,6 +32,9 @@ import numpy as np
 LEAD_FRACTION = 0.1
 # Largest lead (m): a wider one swings the lead point far out in a turn in place.
 MAX_LEAD = 0.05
+# The steering length (m): the heading turns toward the lead point's error within
+# about STEERING / v seconds, slower than a base's latency (200 ms at 0.3 m/s: 6 cm).
+STEERING = 0.1
 # Misalignment (rad) beyond which a robot turns in place instead of following.
 TURN_ANGLE = np.pi / 4
 # A turn in place ends once the heading is this close (rad) to the one it needs.
@@ -101,19 +107,24 @@ def lead_points(positions: np.ndarray, angles: np.ndarray, lead_distance: float)
     return np.asarray(positions, dtype=float) + lead_distance * headings(angles)
 
 
-def follow(desired: np.ndarray, angles: np.ndarray, lead_distance: float, speed_limit: float,
-           yaw_rate_limit: float) -> UnicycleCommand:
-    """
-    Return the command that moves the lead points with velocity lambda x desired (k, 3).
+def steering(lead_distance: float) -> float:
+    """Return the steering length l >= e of the lead e: STEERING, or e if that is longer."""
+    return max(STEERING, lead_distance)
 
-    v = u . h and omega = u . h_perp / e, both scaled by the largest
-    lambda <= 1 within |v| <= speed_limit and |omega| <= yaw_rate_limit, so the
-    lead point's velocity keeps the direction of u.
+
+def follow(desired: np.ndarray, angles: np.ndarray, steering_length: float,
+           speed_limit: float, yaw_rate_limit: float) -> UnicycleCommand:
+    """
+    Return the command that moves the lead points with velocity lambda D desired (k, 3).
+
+    v = u . h and omega = u . h_perp / l, both scaled by the largest
+    lambda <= 1 within |v| <= speed_limit and |omega| <= yaw_rate_limit; a
+    lead point e ahead then moves at lambda (u . h) h + lambda (e / l) (u . h_perp) h_perp.
     """
     h = headings(angles)
     perpendicular = np.stack([-h[:, 1], h[:, 0], np.zeros(len(h))], axis=-1)
     forward = np.einsum('ij,ij->i', desired, h)
-    yaw_rate = np.einsum('ij,ij->i', desired, perpendicular) / lead_distance
+    yaw_rate = np.einsum('ij,ij->i', desired, perpendicular) / steering_length
     tiny = np.finfo(float).tiny
     scale = np.minimum(1.0, np.minimum(speed_limit / np.maximum(np.abs(forward), tiny),
                                        yaw_rate_limit / np.maximum(np.abs(yaw_rate), tiny)))
@@ -143,18 +154,17 @@ def park(positions: np.ndarray, angles: np.ndarray, goals: np.ndarray, gain: flo
     return UnicycleCommand(forward, turn(error, yaw_rate_limit))
 
 
-def creep_rate(angles: np.ndarray, speeds: np.ndarray, lead_distance: float,
+def creep_rate(angles: np.ndarray, speeds: np.ndarray, steering_length: float,
                yaw_rate_limit: float) -> np.ndarray:
     """
     Return the (k,) largest clock rates at which lead points can follow references.
 
     A reference moving at speed |r'| in a direction at angle alpha from the
-    heading asks the lead point to move sideways at rate |r'| |sin alpha|,
-    which takes the yaw rate rate |r'| |sin alpha| / e; the clock leaves it
-    CREEP times the limit. Beyond TURN_ANGLE the robot turns in place first: 0.
+    heading asks for the yaw rate rate |r'| |sin alpha| / l; the clock leaves
+    it CREEP times the limit. Beyond TURN_ANGLE the robot turns in place first: 0.
     """
     sideways = np.asarray(speeds, dtype=float) * np.abs(np.sin(angles))
-    allowed = CREEP * lead_distance * yaw_rate_limit
+    allowed = CREEP * steering_length * yaw_rate_limit
     rates = np.minimum(1.0, allowed / np.maximum(sideways, np.finfo(float).tiny))
     return np.where(np.abs(angles) > TURN_ANGLE, 0.0, rates)
 
@@ -203,7 +213,8 @@ class Corners:
         starts = np.where(has, np.maximum(self.seconds[rows], s), np.inf)
         return directions, starts
 
-    def corner_caps(self, s: float, lead_distance: float, yaw_rate_limit: float) -> np.ndarray:
+    def corner_caps(self, s: float, steering_length: float,
+                    yaw_rate_limit: float) -> np.ndarray:
         """
         Return the (k,) clock rates that slow each robot into the corners ahead.
 
@@ -224,7 +235,7 @@ class Corners:
             beta = wrap(np.arctan2(after[:, 1], after[:, 0])
                         - np.arctan2(before[:, 1], before[:, 0]))
             at_corner = np.maximum(CORNER_RATE, creep_rate(beta, self.speeds[b],
-                                                           lead_distance, yaw_rate_limit))
+                                                           steering_length, yaw_rate_limit))
             ramp = at_corner + (1.0 - at_corner) * (self.seconds[b] - s) / LOOKAHEAD
             caps = np.where(corner, np.minimum(caps, ramp), caps)
         return caps
