@@ -128,6 +128,12 @@ class Graph:
         request.configurations = [pose_array(c, orientations=orientations)
                                   for c in configurations]
         response = self.client.call(self.plan_sequence, request)
+        deadline = time.monotonic() + 10
+        while (response.error_code == PlanSequence.Response.NO_ROBOT_STATE
+               and time.monotonic() < deadline):
+            # the planner's own odometry subscriptions may match a little later than ours
+            self.client.spin_until(lambda: False, 0.2)
+            response = self.client.call(self.plan_sequence, request)
         assert response.error_code == 0, response.error_msg + self.logs()
         return response
 
