@@ -215,3 +215,13 @@ def test_closed_loop_keeps_the_centre_within_the_tolerance(points, tolerance, st
         now += 0.025
     assert np.linalg.norm(fleet.positions - reference.positions[-1]) <= 0.01
     assert abs(unicycle.wrap(fleet.headings[0] - 2.0)) <= 0.05
+
+
+def test_a_reversal_is_driven_backward_not_turned_round():
+    reference = Reference(np.array([0.0, 4.0]), np.array([[[0, 0, 0]], [[-1, 0, 0]]], float),
+                          np.tile([0.0, 0.0, 0.0, 1.0], (2, 1, 1)))
+    execution = Execution(reference, 0.1, ExecutionSettings(
+        drive=('differential',), speed_limit=0.5, yaw_rate_limit=1.9))
+    step = execution.step(0.05, reference.position(0.0), [False], quaternions([0.0]))
+    assert execution.reverse.tolist() == [True] and not execution.turning.any()
+    assert step.forward[0] < 0 and abs(step.yaw_rates[0]) < 1e-9
