@@ -200,6 +200,20 @@ def _write(recorder, response, mcap_path, gif_path):
     print('wrote %s (%d messages) and %s' % (mcap_path, len(messages), gif_path))
 
 
+def _with_drive(params_path, drive, folder):
+    """Return a copy of a parameter file with fleet_sim's and plan_executor's drive set."""
+    # a -p override loses to the file's node sections, so the file itself is changed
+    with open(params_path, encoding='utf-8') as stream:
+        values = yaml.safe_load(stream)
+    for node in ('fleet_sim', 'plan_executor'):
+        section = values.setdefault('/**/' + node, {}).setdefault('ros__parameters', {})
+        section['drive'] = [drive]
+    path = os.path.join(folder, 'params.yaml')
+    with open(path, 'w', encoding='utf-8') as stream:
+        yaml.safe_dump(values, stream)
+    return path
+
+
 def main(argv=None):
     """Run the demo; return 0 when the plan was executed."""
     parser = argparse.ArgumentParser(description='From plan to motion with a simulated fleet.')
@@ -215,11 +229,10 @@ def main(argv=None):
         names = yaml.safe_load(stream)['/**']['ros__parameters']['robot_names']
     logs = tempfile.mkdtemp(prefix='punctured_planner_demo_')
     bin_dir = os.path.dirname(sys.executable)
-    override = {name: ['-p', 'drive:=[%s]' % args.drive] if args.drive and name != 'planner_node'
-                else [] for name in NODES}
+    params = args.params if args.drive is None else _with_drive(args.params, args.drive, logs)
     processes = [subprocess.Popen(
         [os.path.join(bin_dir, name), '--ros-args', '-r', '__ns:=/demo', '--params-file',
-         args.params] + override[name], stdout=open(os.path.join(logs, name + '.log'), 'wb'),
+         params], stdout=open(os.path.join(logs, name + '.log'), 'wb'),
         stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL) for name in NODES]
     print('started %s (logs in %s)' % (', '.join(NODES), logs))
     recorder = None
