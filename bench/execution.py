@@ -299,10 +299,13 @@ def dds_run(the_plan, slow, late, shared_clock, tag, drive='holonomic'):
         headings = [abs(2 * np.arctan2(m.pose.pose.orientation.z, m.pose.pose.orientation.w))
                     for m in (graph.odometry[name][-1][1] for name in graph.names)]
         commands = [m for name in graph.names for _, m in graph.commands[name]]
+        # the largest error while the clock ran: the last feedback before the plan's end
+        running = [f for _, f in feedback if f.plan_time < f.plan_duration]
         figures = {'code': result.error_code, 'message': result.error_msg,
                    'executed': result.executed_duration.sec
                    + result.executed_duration.nanosec * 1e-9, 'wall': wall,
                    'error': max(result.max_tracking_errors), 'gap': graph.gap[-1],
+                   'running': max(running[-1].max_tracking_errors) if running else 0.0,
                    'final': final, 'feedback': len(feedback),
                    'heading': max((h + np.pi) % (2 * np.pi) - np.pi for h in headings),
                    'commands': len(commands),
@@ -437,11 +440,13 @@ def differential_line(differential, holonomic, tolerance):
     return (
         'Differential drive, same plan and faults, shared clock (1.9 rad/s, 1 m/s^2, '
         '8 rad/s^2): result %d, true smallest gap %.3f m, %d contacts, largest tracking '
-        'error %.3f m = %.2f of the tolerance, farthest from its goal %.4f m, largest final '
-        'heading error %.4f rad, executed %.1f s = %.2f x the holonomic run (%.1f s); %d '
-        'cmd_vel messages, %d with a non-zero linear.y.' % (
-            f['code'], f['gap'], f['processes']['fleet_sim'][2], f['error'],
-            f['error'] / tolerance, f['final'], f['heading'], f['executed'],
+        'error while the clock ran %.3f m = %.2f of the tolerance (%.3f m = %.2f over the '
+        'whole run, stops after the end included; holonomic %.3f m and %.3f m), farthest '
+        'from its goal %.4f m, largest final heading error %.4f rad, executed %.1f s = %.2f '
+        'x the holonomic run (%.1f s); %d cmd_vel messages, %d with a non-zero linear.y.' % (
+            f['code'], f['gap'], f['processes']['fleet_sim'][2], f['running'],
+            f['running'] / tolerance, f['error'], f['error'] / tolerance,
+            holonomic['running'], holonomic['error'], f['final'], f['heading'], f['executed'],
             f['executed'] / holonomic['executed'], holonomic['executed'], f['commands'],
             f['sideways']))
 

@@ -135,6 +135,10 @@ class Graph:
             self.client.spin_until(lambda: False, 0.2)
             response = self.client.call(self.plan_sequence, request)
         assert response.error_code == 0, response.error_msg + self.logs()
+        # the latched plan reaches the executor on its own topic, maybe after the response
+        executor = self.processes['plan_executor']
+        assert self.client.spin_until(
+            lambda: 'plan %d:' % response.plan_id in executor.log(), 10), self.logs()
         return response
 
     def set_sim(self, **values):

@@ -219,23 +219,28 @@ class Corners:
         Return the (k,) clock rates that slow each robot into the corners ahead.
 
         A corner is a breakpoint at plan time t in (s, s + LOOKAHEAD] where robot i's
-        reference moves on both sides and turns by beta. It must be passed at
-        most at creep_rate(beta) (CORNER_RATE if beta needs a turn in place),
-        and the cap rises linearly to 1 over LOOKAHEAD plan seconds before it.
+        reference moves before and turns by beta, or stops (the plan's end too):
+        a base with an acceleration limit cannot stop at once either. It must be
+        passed at most at creep_rate(beta) (CORNER_RATE if beta needs a turn in
+        place or the reference stops), and the cap rises linearly to 1 over
+        LOOKAHEAD plan seconds before it.
         """
         k = self.speeds.shape[1] if self.speeds.size else 0
         caps = np.ones(k)
         first = np.searchsorted(self.seconds, s, side='right')
         last = np.searchsorted(self.seconds, s + LOOKAHEAD, side='right')
-        for b in range(max(first, 1), min(last, len(self.speeds))):
-            before, after = self.velocities[b - 1], self.velocities[b]
-            corner = (self.speeds[b - 1] > STILL) & (self.speeds[b] > STILL)
+        for b in range(max(first, 1), min(last, len(self.speeds) + 1)):
+            before = self.velocities[b - 1]
+            after = self.velocities[b] if b < len(self.speeds) else np.zeros_like(before)
+            speeds_after = np.linalg.norm(after, axis=-1)
+            corner = self.speeds[b - 1] > STILL
             if not corner.any():
                 continue
             beta = wrap(np.arctan2(after[:, 1], after[:, 0])
                         - np.arctan2(before[:, 1], before[:, 0]))
-            at_corner = np.maximum(CORNER_RATE, creep_rate(beta, self.speeds[b],
+            at_corner = np.maximum(CORNER_RATE, creep_rate(beta, speeds_after,
                                                            steering_length, yaw_rate_limit))
+            at_corner = np.where(speeds_after > STILL, at_corner, CORNER_RATE)
             ramp = at_corner + (1.0 - at_corner) * (self.seconds[b] - s) / LOOKAHEAD
             caps = np.where(corner, np.minimum(caps, ramp), caps)
         return caps
