@@ -21,16 +21,16 @@ smallest robot-pillar slack; each knot's total move in the block is split into
 the fleet's common translation (which robot pairs do not feel) and each
 robot's own part, each clipped to its caps and to a fixed step. Gap distance
 is 1-Lipschitz in each robot's position, so no gap falls below g0 (the caps
-lemma). Every quantity is a continuous function of the input; pairs are left
-out only where their cap term provably exceeds the step (so leaving them out
-changes nothing), and the number of blocks, sweeps and knots is fixed, so the
-map stays continuous on every domain (doc/design.md section 14).
+lemma). A lower bound of the slack gives safe caps too: the enclosing balls'
+distance for every pair, the exact slack only where that comes within EXACT
+step, blended continuously. Every quantity is a continuous function of the
+input, and the number of blocks, sweeps and knots is fixed, so the map stays
+continuous on every domain (doc/design.md section 14).
 """
 
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from .certificate import certify, segment_minimum
 
@@ -61,8 +61,12 @@ PAIR_SHARE, PILLAR_SHARE = 0.25, 0.5
 # (4: the smallest pair slack itself; more would make the caps steep, and continuity
 # weaker, for nothing but rounding).
 _TRANSLATION = 4.0
-# Up to this many robots every pair is checked on every interval (pruning costs more).
-_ALL_PAIRS = 24
+# The exact slack (closed form per leg) is computed only for pairs whose enclosing balls
+# over an interval come within EXACT x the step; farther ones use the balls' distance, a
+# lower bound (design, 14).
+EXACT = 0.1
+# Interval-robot-robot entries of the ball distances computed at once.
+_CHUNK = 1 << 20
 
 
 @dataclass(frozen=True, eq=False)
@@ -160,6 +164,14 @@ class _Knots:
         return (1.0 - f) * values[self.interval] + f * values[self.interval + 1]
 
 
+def _length(vectors):
+    """Return the lengths (...) of vectors (..., d); a sum per coordinate is faster."""
+    squared = vectors[..., 0] * vectors[..., 0]
+    for axis in range(1, vectors.shape[-1]):
+        squared = squared + vectors[..., axis] * vectors[..., axis]
+    return np.sqrt(squared)
+
+
 def _enclosing_balls(motion, knots):
     """
     Return (centres (N - 1, k, d), radii (N - 1, k)): a ball holding each robot per interval.
@@ -171,37 +183,32 @@ def _enclosing_balls(motion, knots):
     """
     centres = 0.5 * (motion[knots.points[:-1]] + motion[knots.points[1:]])
     owner = np.minimum(knots.interval, centres.shape[0] - 1)
-    distance = np.sqrt(((motion - centres[owner]) ** 2).sum(axis=2))
+    distance = _length(motion - centres[owner])
     radii = np.maximum.reduceat(distance, knots.points[:-1], axis=0)
     # reduceat stops short of each interval's end knot, which starts the next interval.
-    end = np.sqrt(((motion[knots.points[1:]] - centres) ** 2).sum(axis=2))
+    end = _length(motion[knots.points[1:]] - centres)
     return centres, np.maximum(radii, end)
 
 
-def _pair_candidates(centres, radii, reach):
+def _ball_pairs(centres, radii, chunk):
     """
-    Return (interval, a, b), a < b, of the robot pairs whose balls come within reach.
+    Return (I, k, k) every robot pair's enclosing balls' distance over each interval.
 
-    Few robots: every pair. Many: one tree over all (interval, robot) balls,
-    intervals set far apart along an extra axis. A pair left out is more than
-    reach apart over its whole interval.
+    |c_a - c_b| - r_a - r_b: a lower bound of the pair's distance over the
+    whole interval, continuous in the motion; the diagonal is +inf. chunk
+    intervals at a time keep the temporaries small.
     """
-    intervals, k, d = centres.shape
-    if k <= _ALL_PAIRS:
-        a, b = np.triu_indices(k, 1)
-        interval = np.repeat(np.arange(intervals), a.size)
-        a, b = np.tile(a, intervals), np.tile(b, intervals)
-    else:
-        flat = centres.reshape(-1, d)
-        span = float(np.ptp(flat, axis=0).max()) + 2 * float(radii.max()) + reach + 1.0
-        apart = (np.repeat(np.arange(intervals), k) * 2 * span)[:, None]
-        found = cKDTree(np.concatenate([flat, apart], axis=1)).query_pairs(
-            reach + 2 * float(radii.max()), output_type='ndarray').reshape(-1, 2)
-        interval, a = np.divmod(found.min(axis=1), k)
-        b = found.max(axis=1) % k
-    distance = np.sqrt(((centres[interval, a] - centres[interval, b]) ** 2).sum(axis=1))
-    near = distance - radii[interval, a] - radii[interval, b] < reach
-    return interval[near], a[near], b[near]
+    intervals, k, _ = centres.shape
+    result = np.empty((intervals, k, k))
+    for first in range(0, intervals, chunk):
+        c, r = centres[first:first + chunk], radii[first:first + chunk]
+        squared = np.zeros((c.shape[0], k, k))
+        for axis in range(c.shape[2]):
+            difference = c[:, :, None, axis] - c[:, None, :, axis]
+            squared += difference * difference
+        result[first:first + chunk] = np.sqrt(squared) - r[:, :, None] - r[:, None, :]
+    result[:, np.arange(k), np.arange(k)] = np.inf
+    return result
 
 
 def _interval_legs(knots, interval):
@@ -230,13 +237,13 @@ class _Caps:
     """
     Each robot's caps at every knot: (N, k) for its robot pairs and for the pillars.
 
-    From the exact slack (closed form per leg) of robot pairs and robot-pillar
-    pairs over each knot interval: a quarter (PAIR_SHARE) of the smallest pair
-    slack, half (PILLAR_SHARE) of the smallest pillar slack, over the two
-    intervals each knot's hat covers; 0 at the configurations. A pair whose
-    enclosing balls already keep a slack of 4 step is left out: its cap term
-    would be at least step (2 step for a pillar), which the block's caps never
-    exceed, so leaving it out changes nothing (design, 14).
+    From a lower bound of the slack of robot pairs and robot-pillar pairs over
+    each knot interval: a quarter (PAIR_SHARE) of the smallest pair slack, half
+    (PILLAR_SHARE) of the smallest pillar slack, over the two intervals each
+    knot's hat covers, at most step (2 step for a pillar); 0 at the
+    configurations. The bound is the enclosing balls' distance, tightened by
+    the exact slack (closed form per leg) where the balls come within EXACT
+    step (_tightened; design, 14).
     """
 
     def __init__(self, motion, knots, bodies, step):
@@ -245,33 +252,46 @@ class _Caps:
         intervals, k, d = centres.shape
         planes = np.ascontiguousarray(np.moveaxis(motion, 2, 0))
         floor = bodies.margin + bodies.rounding
-        prune = 4 * step
+        exact_below = EXACT * step
         pair = np.full((intervals, k), step)
         if k > 1:
-            radius = bodies.radii[0]
-            interval, a, b = _pair_candidates(centres, radii, prune + 2 * radius + floor)
+            offset = 2 * bodies.radii[0] + floor
+            ball = _ball_pairs(centres, radii, max(1, _CHUNK // (k * k))) - offset
+            interval, a, b = np.nonzero(np.triu(ball < exact_below, 1))
             if interval.size:
                 legs, owner = _interval_legs(knots, interval)
                 slack = np.full(interval.size, np.inf)
                 np.minimum.at(slack, owner, _leg_minima(planes, legs, a[owner], b[owner]))
-                share = PAIR_SHARE * np.maximum(slack - 2 * radius - floor, 0.0)
-                np.minimum.at(pair, (interval, a), share)
-                np.minimum.at(pair, (interval, b), share)
+                slack = _tightened(ball[interval, a, b], slack - offset, exact_below)
+                ball[interval, a, b] = ball[interval, b, a] = slack
+            pair = np.minimum(pair, PAIR_SHARE * np.maximum(ball.min(axis=2), 0.0))
         pillar = np.full((intervals, k), 2 * step)
         if len(bodies.obstacles):
             pillars = bodies.obstacles
             offsets = bodies.radii[:k][None, :, None] + bodies.radii[None, None, k:] + floor
-            ball = (np.sqrt(((centres[:, :, None, :] - pillars[None, None]) ** 2).sum(axis=3))
+            ball = (_length(centres[:, :, None, :] - pillars[None, None])
                     - radii[:, :, None] - offsets)
-            interval, a, q = np.nonzero(ball < prune)
+            interval, a, q = np.nonzero(ball < exact_below)
             if interval.size:
                 legs, owner = _interval_legs(knots, interval)
                 slack = np.full(interval.size, np.inf)
                 np.minimum.at(slack, owner,
                               _leg_minima(planes, legs, a[owner], pillars[q[owner]].T))
-                share = PILLAR_SHARE * np.maximum(slack - offsets[0, a, q], 0.0)
-                np.minimum.at(pillar, (interval, a), share)
+                ball[interval, a, q] = _tightened(ball[interval, a, q],
+                                                  slack - offsets[0, a, q], exact_below)
+            pillar = np.minimum(pillar, PILLAR_SHARE * np.maximum(ball.min(axis=2), 0.0))
         self.pair, self.pillar = _knot_caps(pair), _knot_caps(pillar)
+
+
+def _tightened(ball, exact, below):
+    """
+    Return max(ball, min(exact, below)): a lower bound of the slack, continuous.
+
+    Both bounds are lower bounds (ball <= exact), so is this; where ball >= below
+    it is ball itself, so the exact slack is needed only where ball < below, and
+    a pair entering or leaving that set changes nothing abruptly.
+    """
+    return np.maximum(ball, np.minimum(exact, below))
 
 
 def _knot_caps(bound):
@@ -284,7 +304,7 @@ def _knot_caps(bound):
 
 def _clipped(move, caps):
     """Return the moves (..., d) scaled down to lengths <= caps (...); zero at cap 0."""
-    length = np.sqrt((move * move).sum(axis=-1))
+    length = _length(move)
     over = length > caps
     scale = np.where(over, caps / np.where(over, length, 1.0), 1.0)
     return move * scale[..., None]
@@ -319,7 +339,7 @@ class _Block:
         common is the fleet's mean, clipped; own what each robot still wants, clipped.
         """
         common = _clipped(wanted.mean(axis=1), self.common_cap)
-        left = self.pillar - np.sqrt((common * common).sum(axis=1))[:, None]
+        left = self.pillar - _length(common)[:, None]
         own = _clipped(wanted - common[:, None], np.minimum(np.minimum(self.pair, left),
                                                             self.step))
         return common, own
