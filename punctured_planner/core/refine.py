@@ -65,8 +65,6 @@ _TRANSLATION = 4.0
 # over an interval come within EXACT x the step; farther ones use the balls' distance, a
 # lower bound (design, 14).
 EXACT = 0.1
-# Interval-robot-robot entries of the ball distances computed at once.
-_CHUNK = 1 << 20
 
 
 @dataclass(frozen=True, eq=False)
@@ -190,23 +188,25 @@ def _enclosing_balls(motion, knots):
     return centres, np.maximum(radii, end)
 
 
-def _ball_pairs(centres, radii, chunk):
+def _ball_pairs(centres, radii):
     """
     Return (I, k, k) every robot pair's enclosing balls' distance over each interval.
 
     |c_a - c_b| - r_a - r_b: a lower bound of the pair's distance over the
-    whole interval, continuous in the motion; the diagonal is +inf. chunk
-    intervals at a time keep the temporaries small.
+    whole interval, continuous in the motion; the diagonal is +inf. In place,
+    a coordinate at a time (the temporaries dominate the cost otherwise).
     """
-    intervals, k, _ = centres.shape
-    result = np.empty((intervals, k, k))
-    for first in range(0, intervals, chunk):
-        c, r = centres[first:first + chunk], radii[first:first + chunk]
-        squared = np.zeros((c.shape[0], k, k))
-        for axis in range(c.shape[2]):
-            difference = c[:, :, None, axis] - c[:, None, :, axis]
-            squared += difference * difference
-        result[first:first + chunk] = np.sqrt(squared) - r[:, :, None] - r[:, None, :]
+    intervals, k, d = centres.shape
+    result, term = np.empty((intervals, k, k)), np.empty((intervals, k, k))
+    np.subtract(centres[:, :, None, 0], centres[:, None, :, 0], out=result)
+    np.multiply(result, result, out=result)
+    for axis in range(1, d):
+        np.subtract(centres[:, :, None, axis], centres[:, None, :, axis], out=term)
+        np.multiply(term, term, out=term)
+        result += term
+    np.sqrt(result, out=result)
+    result -= radii[:, :, None]
+    result -= radii[:, None, :]
     result[:, np.arange(k), np.arange(k)] = np.inf
     return result
 
@@ -256,7 +256,8 @@ class _Caps:
         pair = np.full((intervals, k), step)
         if k > 1:
             offset = 2 * bodies.radii[0] + floor
-            ball = _ball_pairs(centres, radii, max(1, _CHUNK // (k * k))) - offset
+            ball = _ball_pairs(centres, radii)
+            ball -= offset
             interval, a, b = np.nonzero(np.triu(ball < exact_below, 1))
             if interval.size:
                 legs, owner = _interval_legs(knots, interval)
