@@ -21,11 +21,10 @@ smallest robot-pillar slack; each knot's total move in the block is split into
 the fleet's common translation (which robot pairs do not feel) and each
 robot's own part, each clipped to its caps and to a fixed step. Gap distance
 is 1-Lipschitz in each robot's position, so no gap falls below g0 (the caps
-lemma). A lower bound of the slack gives safe caps too: the enclosing balls'
-distance for every pair, the exact slack only where that comes within EXACT
-step, blended continuously. Every quantity is a continuous function of the
-input, and the number of blocks, sweeps and knots is fixed, so the map stays
-continuous on every domain (doc/design.md section 14).
+lemma). Every pair is evaluated, so no pair enters or leaves the checked set;
+every quantity is a continuous function of the input, and the number of
+blocks, sweeps and knots is fixed, so the map stays continuous on every domain
+(doc/design.md section 14).
 """
 
 from dataclasses import dataclass
@@ -36,8 +35,8 @@ from .certificate import certify, segment_minimum
 
 # Knots per segment: the field is piecewise linear on the j / KNOTS fractions.
 KNOTS = 64
-# A block computes the caps once (the costly part: the exact slack of every pair near
-# enough to matter), then runs SWEEPS red-black sweeps of over-relaxed smoothing
+# A block computes the caps once (the costly part: the exact slack of every pair
+# near enough to matter), then runs SWEEPS red-black sweeps of over-relaxed smoothing
 # (successive over-relaxation: O(KNOTS) sweeps where plain smoothing, like diffusion,
 # needs O(KNOTS^2)), each knot's total move in the block clipped to its caps. Fresh caps
 # let robots use the room they made, so more blocks shorten more; but a block's caps
@@ -61,10 +60,9 @@ PAIR_SHARE, PILLAR_SHARE = 0.25, 0.5
 # (4: the smallest pair slack itself; more would make the caps steep, and continuity
 # weaker, for nothing but rounding).
 _TRANSLATION = 4.0
-# The exact slack (closed form per leg) is computed only for pairs whose enclosing balls
-# over an interval come within EXACT x the step; farther ones use the balls' distance, a
-# lower bound (design, 14).
-EXACT = 0.1
+# Entries (coordinate x leg x robot x robot or pillar) of the slack arrays computed at
+# once.
+_ENTRIES = 1 << 21
 
 
 @dataclass(frozen=True, eq=False)
@@ -170,129 +168,72 @@ def _length(vectors):
     return np.sqrt(squared)
 
 
-def _enclosing_balls(motion, knots):
+def _interval_minima(planes, knots, pillars=None):
     """
-    Return (centres (N - 1, k, d), radii (N - 1, k)): a ball holding each robot per interval.
+    Return (N - 1, k, m) the exact smallest distance over each knot interval, densely.
 
-    The centre is the midpoint of the robot's positions at the interval's two
-    knots; the radius the farthest breakpoint from it, so the whole piece of
-    motion (linear between breakpoints) lies in the ball. Both are continuous
-    in the motion.
+    From every robot to every robot (m = k, the diagonal +inf) or, with pillars
+    (m, d), to every pillar: the closed form on every leg of the union, then
+    the minimum over each interval's legs. planes is the motion coordinate
+    first (d, U, k). Dense arrays over a few hundred legs cost less than
+    choosing pairs would; a run of whole intervals at a time bounds the
+    temporaries (the grouping does not change any value).
     """
-    centres = 0.5 * (motion[knots.points[:-1]] + motion[knots.points[1:]])
-    owner = np.minimum(knots.interval, centres.shape[0] - 1)
-    distance = _length(motion - centres[owner])
-    radii = np.maximum.reduceat(distance, knots.points[:-1], axis=0)
-    # reduceat stops short of each interval's end knot, which starts the next interval.
-    end = _length(motion[knots.points[1:]] - centres)
-    return centres, np.maximum(radii, end)
-
-
-def _ball_pairs(centres, radii):
-    """
-    Return (I, k, k) every robot pair's enclosing balls' distance over each interval.
-
-    |c_a - c_b| - r_a - r_b: a lower bound of the pair's distance over the
-    whole interval, continuous in the motion; the diagonal is +inf. In place,
-    a coordinate at a time (the temporaries dominate the cost otherwise).
-    """
-    intervals, k, d = centres.shape
-    result, term = np.empty((intervals, k, k)), np.empty((intervals, k, k))
-    np.subtract(centres[:, :, None, 0], centres[:, None, :, 0], out=result)
-    np.multiply(result, result, out=result)
-    for axis in range(1, d):
-        np.subtract(centres[:, :, None, axis], centres[:, None, :, axis], out=term)
-        np.multiply(term, term, out=term)
-        result += term
-    np.sqrt(result, out=result)
-    result -= radii[:, :, None]
-    result -= radii[:, None, :]
-    result[:, np.arange(k), np.arange(k)] = np.inf
+    d, _, k = planes.shape
+    # Robot pairs a < b only (np.take keeps the pairs last and contiguous), then mirrored.
+    a, b = np.triu_indices(k, 1)
+    width = a.size if pillars is None else k * pillars.shape[0]
+    points = knots.points
+    minima = np.empty((points.size - 1, width))
+    legs = max(1, _ENTRIES // (d * max(width, 1)))
+    first = 0
+    while first < minima.shape[0]:
+        last = int(np.searchsorted(points, points[first] + legs, side='right')) - 1
+        last = min(max(last, first + 1), minima.shape[0])
+        piece = planes[:, points[first]:points[last] + 1]
+        if pillars is None:
+            relative = np.take(piece, a, axis=2) - np.take(piece, b, axis=2)
+        else:
+            relative = (piece[:, :, :, None] - pillars.T[:, None, None, :]).reshape(
+                d, piece.shape[1], width)
+        squared, _ = segment_minimum(relative[:, :-1], relative[:, 1:] - relative[:, :-1])
+        minima[first:last] = np.sqrt(np.minimum.reduceat(
+            squared, points[first:last] - points[first], axis=0))
+        first = last
+    if pillars is not None:
+        return minima.reshape(minima.shape[0], k, pillars.shape[0])
+    result = np.full((minima.shape[0], k, k), np.inf)
+    result[:, a, b] = minima
+    result[:, b, a] = minima
     return result
-
-
-def _interval_legs(knots, interval):
-    """Return (legs, owner): the union legs of each listed interval, and the list entry."""
-    count = (knots.points[1:] - knots.points[:-1])[interval]
-    owner = np.repeat(np.arange(interval.size), count)
-    first = np.repeat(knots.points[interval] - (np.cumsum(count) - count), count)
-    return first + np.arange(owner.size), owner
-
-
-def _leg_minima(planes, legs, a, b):
-    """
-    Return the smallest |x_a - x_b| over each leg, exactly.
-
-    planes is the motion coordinate first (d, U, k); b is robots, or a fixed
-    point per entry (d, entries).
-    """
-    start = planes[:, legs, a] - (planes[:, legs, b] if b.ndim == 1 else b)
-    end = planes[:, legs + 1, a] - (planes[:, legs + 1, b] if b.ndim == 1 else b)
-    end -= start
-    squared, _ = segment_minimum(start, end)
-    return np.sqrt(squared)
 
 
 class _Caps:
     """
     Each robot's caps at every knot: (N, k) for its robot pairs and for the pillars.
 
-    From a lower bound of the slack of robot pairs and robot-pillar pairs over
-    each knot interval: a quarter (PAIR_SHARE) of the smallest pair slack, half
-    (PILLAR_SHARE) of the smallest pillar slack, over the two intervals each
-    knot's hat covers, at most step (2 step for a pillar); 0 at the
-    configurations. The bound is the enclosing balls' distance, tightened by
-    the exact slack (closed form per leg) where the balls come within EXACT
-    step (_tightened; design, 14).
+    From the exact slack (closed form per leg) of every robot pair and every
+    robot-pillar pair over each knot interval: a quarter (PAIR_SHARE) of the
+    smallest pair slack, half (PILLAR_SHARE) of the smallest pillar slack, over
+    the two intervals each knot's hat covers, at most step (2 step for a
+    pillar); 0 at the configurations (design, 14).
     """
 
     def __init__(self, motion, knots, bodies, step):
         """Compute the caps for the motion at the union's breakpoints (U, k, d)."""
-        centres, radii = _enclosing_balls(motion, knots)
-        intervals, k, d = centres.shape
+        intervals, k = knots.points.size - 1, motion.shape[1]
         planes = np.ascontiguousarray(np.moveaxis(motion, 2, 0))
         floor = bodies.margin + bodies.rounding
-        exact_below = EXACT * step
         pair = np.full((intervals, k), step)
         if k > 1:
-            offset = 2 * bodies.radii[0] + floor
-            ball = _ball_pairs(centres, radii)
-            ball -= offset
-            interval, a, b = np.nonzero(np.triu(ball < exact_below, 1))
-            if interval.size:
-                legs, owner = _interval_legs(knots, interval)
-                slack = np.full(interval.size, np.inf)
-                np.minimum.at(slack, owner, _leg_minima(planes, legs, a[owner], b[owner]))
-                slack = _tightened(ball[interval, a, b], slack - offset, exact_below)
-                ball[interval, a, b] = ball[interval, b, a] = slack
-            pair = np.minimum(pair, PAIR_SHARE * np.maximum(ball.min(axis=2), 0.0))
+            slack = _interval_minima(planes, knots).min(axis=2) - 2 * bodies.radii[0] - floor
+            pair = np.minimum(pair, PAIR_SHARE * np.maximum(slack, 0.0))
         pillar = np.full((intervals, k), 2 * step)
         if len(bodies.obstacles):
-            pillars = bodies.obstacles
-            offsets = bodies.radii[:k][None, :, None] + bodies.radii[None, None, k:] + floor
-            ball = (_length(centres[:, :, None, :] - pillars[None, None])
-                    - radii[:, :, None] - offsets)
-            interval, a, q = np.nonzero(ball < exact_below)
-            if interval.size:
-                legs, owner = _interval_legs(knots, interval)
-                slack = np.full(interval.size, np.inf)
-                np.minimum.at(slack, owner,
-                              _leg_minima(planes, legs, a[owner], pillars[q[owner]].T))
-                ball[interval, a, q] = _tightened(ball[interval, a, q],
-                                                  slack - offsets[0, a, q], exact_below)
-            pillar = np.minimum(pillar, PILLAR_SHARE * np.maximum(ball.min(axis=2), 0.0))
+            offsets = bodies.radii[:k, None] + bodies.radii[None, k:] + floor
+            slack = (_interval_minima(planes, knots, bodies.obstacles) - offsets).min(axis=2)
+            pillar = np.minimum(pillar, PILLAR_SHARE * np.maximum(slack, 0.0))
         self.pair, self.pillar = _knot_caps(pair), _knot_caps(pillar)
-
-
-def _tightened(ball, exact, below):
-    """
-    Return max(ball, min(exact, below)): a lower bound of the slack, continuous.
-
-    Both bounds are lower bounds (ball <= exact), so is this; where ball >= below
-    it is ball itself, so the exact slack is needed only where ball < below, and
-    a pair entering or leaving that set changes nothing abruptly.
-    """
-    return np.maximum(ball, np.minimum(exact, below))
 
 
 def _knot_caps(bound):
