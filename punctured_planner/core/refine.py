@@ -42,7 +42,7 @@ KNOTS = 64
 # let robots use the room they made, so more blocks shorten more; but a block's caps
 # follow the motion (a pillar cap moves by up to half of what the motion moves), so
 # each block can amplify a change of input, and BLOCKS bounds that (measured: a 1e-7
-# change moves the refined motion 5 - 22x that, the construction's 2 - 4x).
+# change moves the refined motion 3 - 34x that, the construction's 2 - 6x).
 BLOCKS, SWEEPS = 12, 6
 # A block's cost grows like k^2 (all pairs near each other somewhere): beyond FULL_ROBOTS
 # robots the blocks fall as FULL_ROBOTS / k, and beyond MAX_ROBOTS none is run (the
