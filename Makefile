@@ -80,6 +80,7 @@ help:
 	@echo 'make bench  benchmarks beside OMPL (a few minutes): bench/results.md, results.png'
 	@echo '           and plan execution over DDS: bench/execution.md'
 	@echo 'make demo   simulated fleet + planner + executor: demo.mcap, demo.gif'
+	@echo '            (DRIVE=differential: four TurtleBot-like differential robots)'
 	@echo 'make lock   re-resolve requirements.txt into constraints.txt'
 	@echo 'make clean  remove .venv and caches'
 
@@ -128,8 +129,12 @@ bench: setup
 	$(VPY) bench/execution.py $(BENCH_ARGS)
 
 # A simulated fleet, the planner and the executor: plan, execute, record (about a minute).
+# DRIVE=differential: four TurtleBot 4-like differential robots (config/demo_differential*).
+DRIVE ?= holonomic
+DEMO_ARGS_differential = --params config/demo_differential.yaml \
+	--request config/demo_differential_request.yaml
 demo: setup
-	$(VPY) -m punctured_planner.demo
+	$(VPY) -m punctured_planner.demo $(DEMO_ARGS_$(DRIVE))
 
 # Discovery stays on this machine unless ROS_AUTOMATIC_DISCOVERY_RANGE says otherwise.
 run: setup

@@ -10,6 +10,7 @@ import argparse
 import cProfile
 from functools import partial
 import io
+import os
 import pstats
 import sys
 import time
@@ -262,7 +263,9 @@ def profile_text(call, repeats, lines=14, sort='tottime', restrict=None):
     out = io.StringIO()
     stats = pstats.Stats(profiler, stream=out).sort_stats(sort)
     stats.print_stats(*([restrict] if restrict else []), lines)
-    text = out.getvalue()
+    # Paths relative to the checkout: the figures name no machine's folders.
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__))) + os.sep
+    text = out.getvalue().replace(root, '')
     return text[text.find('ncalls'):].rstrip()
 
 

@@ -11,7 +11,10 @@ bench/execution.py [--quick]``) and writes bench/execution.md. Two parts:
 2. Over DDS: fleet_sim and plan_executor as processes, the plan published on
    ``plan`` as planner_node publishes it (conversions.plan_message), the goal
    sent through the ExecutePlan action: with the shared clock, without it,
-   then a run with a robot's odometry muted for 2 s and a cancel.
+   then a run with a robot's odometry muted for 2 s and a cancel; then the same
+   plan with the same faults on differential-drive robots (1.9 rad/s, 1 m/s^2,
+   8 rad/s^2), every cmd_vel checked for a zero linear.y (``--drives``: only the
+   two shared-clock runs, holonomic and differential, printed).
 
 The plan comes from the core with robot_radius 0.1 m (spread variant), in a
 12 m x 14 m hall with 3 pillars; its min_gap is the exact surface gap.
@@ -118,7 +121,7 @@ def sweep(the_plan, quick):
 class Graph:
     """fleet_sim and plan_executor processes, and this process's client node."""
 
-    def __init__(self, the_plan, slow, late, shared_clock, tag):
+    def __init__(self, the_plan, slow, late, shared_clock, tag, drive='holonomic'):
         """Start both processes in a fresh namespace and connect a client to them."""
         import rclpy
         from geometry_msgs.msg import Twist
@@ -138,7 +141,7 @@ class Graph:
             'factors': np.where(np.arange(K) == slow, 0.5, 1.0).tolist(),
             'latencies': np.where(np.arange(K) == late, LATENCY, 0.0).tolist(),
             'obstacles': xyz(OBSTACLES).ravel().tolist(),
-            'clock': 'on' if shared_clock else 'off'})
+            'clock': 'on' if shared_clock else 'off', 'drive': drive})
         params.close()
         self.logs = {}
         self.processes = {}
@@ -266,17 +269,23 @@ PARAMETERS = """
     latencies: %(latencies)s
     velocity_noise: 0.05
     rate: 20.0
+    drive: [%(drive)s]
+    yaw_rate_limit: 1.9
+    max_acceleration: 1.0
+    max_yaw_acceleration: 8.0
 /**/plan_executor:
   ros__parameters:
     speed_limit: 0.5
     control_rate: 20.0
     shared_clock: '%(clock)s'
+    drive: [%(drive)s]
+    yaw_rate_limit: 1.9
 """
 
 
-def dds_run(the_plan, slow, late, shared_clock, tag):
+def dds_run(the_plan, slow, late, shared_clock, tag, drive='holonomic'):
     """One full execution over DDS; return a dict of figures."""
-    graph = Graph(the_plan, slow, late, shared_clock, tag)
+    graph = Graph(the_plan, slow, late, shared_clock, tag, drive)
     try:
         graph.publish_plan(the_plan, 1)
         started = time.monotonic()
@@ -286,11 +295,21 @@ def dds_run(the_plan, slow, late, shared_clock, tag):
         graph.spin(lambda: False, 0.5)
         final = np.linalg.norm(graph.positions() - xyz(the_plan.configurations[-1]),
                                axis=1).max()
+        # the plan's orientations are the identity: every robot is asked to face +x
+        headings = [abs(2 * np.arctan2(m.pose.pose.orientation.z, m.pose.pose.orientation.w))
+                    for m in (graph.odometry[name][-1][1] for name in graph.names)]
+        commands = [m for name in graph.names for _, m in graph.commands[name]]
+        # the largest error while the clock ran: the last feedback before the plan's end
+        running = [f for _, f in feedback if f.plan_time < f.plan_duration]
         figures = {'code': result.error_code, 'message': result.error_msg,
                    'executed': result.executed_duration.sec
                    + result.executed_duration.nanosec * 1e-9, 'wall': wall,
                    'error': max(result.max_tracking_errors), 'gap': graph.gap[-1],
-                   'final': final, 'feedback': len(feedback)}
+                   'running': max(running[-1].max_tracking_errors) if running else 0.0,
+                   'final': final, 'feedback': len(feedback),
+                   'heading': max((h + np.pi) % (2 * np.pi) - np.pi for h in headings),
+                   'commands': len(commands),
+                   'sideways': sum(1 for m in commands if m.linear.y != 0.0)}
     finally:
         figures_close = graph.close()
     figures['processes'] = figures_close
@@ -347,7 +366,7 @@ def stale_and_cancel(the_plan, slow, late):
 
 # ---------------------------------------------------------------- report
 
-def report(the_plan, rows, slow, late, shared, unshared, cancel):
+def report(the_plan, rows, slow, late, shared, unshared, cancel, differential):
     """Return the Markdown of bench/execution.md."""
     from punctured_planner.execution import tracking_tolerance
     nominal = the_plan.duration(SPEED)
@@ -378,6 +397,7 @@ def report(the_plan, rows, slow, late, shared, unshared, cancel):
         lines.append('| %s | %d | %.3f m | %d | %.2f (%.1f s) | %.2f | %.4f m | %s |' % (
             label, f['code'], f['gap'], f['processes']['fleet_sim'][2],
             f['executed'] / at_slow, f['executed'], f['error'] / tolerance, f['final'], exits))
+    lines += ['', differential_line(differential, shared, tolerance)]
     held, stale = cancel['held']
     lines += [
         '',
@@ -414,15 +434,42 @@ def report(the_plan, rows, slow, late, shared, unshared, cancel):
     return '\n'.join(lines)
 
 
+def differential_line(differential, holonomic, tolerance):
+    """Return the sentence on the differential robots' run against the holonomic one."""
+    f = differential
+    return (
+        'Differential drive, same plan and faults, shared clock (1.9 rad/s, 1 m/s^2, '
+        '8 rad/s^2): result %d, true smallest gap %.3f m, %d contacts, largest tracking '
+        'error while the clock ran %.3f m = %.2f of the tolerance (%.3f m = %.2f over the '
+        'whole run, stops after the end included; holonomic %.3f m and %.3f m), farthest '
+        'from its goal %.4f m, largest final heading error %.4f rad, executed %.1f s = %.2f '
+        'x the holonomic run (%.1f s); %d cmd_vel messages, %d with a non-zero linear.y.' % (
+            f['code'], f['gap'], f['processes']['fleet_sim'][2], f['running'],
+            f['running'] / tolerance, f['error'], f['error'] / tolerance,
+            holonomic['running'], holonomic['error'], f['final'], f['heading'], f['executed'],
+            f['executed'] / holonomic['executed'], holonomic['executed'], f['commands'],
+            f['sideways']))
+
+
 def main(argv=None):
     """Run both parts, print and write bench/execution.md."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
     parser.add_argument('--quick', action='store_true', help='2 runs without DDS only')
+    parser.add_argument('--drives', action='store_true',
+                        help='only the shared-clock DDS runs, holonomic and differential')
     args = parser.parse_args(argv)
     os.environ.setdefault('ROS_DOMAIN_ID', str(1 + (os.getpid() + 30) % 101))
     os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
     os.environ.setdefault('ROS_LOG_DIR', tempfile.mkdtemp(prefix='pp_execution_log_'))
     the_plan = core_plan()
+    if args.drives:
+        from punctured_planner.execution import tracking_tolerance
+        shared = dds_run(the_plan, 0, 1, True, 'shared')
+        print('DDS shared clock:', shared, flush=True)
+        differential = dds_run(the_plan, 0, 1, True, 'diff', 'differential')
+        print('DDS differential:', differential, flush=True)
+        print(differential_line(differential, shared, tracking_tolerance(the_plan.min_gap)))
+        return 0
     rows = sweep(the_plan, args.quick)
     for row in rows:
         print('slow %d late %d: shared %s | own stamps %s' % row, flush=True)
@@ -436,7 +483,9 @@ def main(argv=None):
     print('DDS own stamps:', unshared, flush=True)
     cancel = stale_and_cancel(the_plan, slow, late)
     print('DDS stale and cancel:', cancel, flush=True)
-    text = report(the_plan, rows, slow, late, shared, unshared, cancel)
+    differential = dds_run(the_plan, slow, late, True, 'diff', 'differential')
+    print('DDS differential:', differential, flush=True)
+    text = report(the_plan, rows, slow, late, shared, unshared, cancel, differential)
     with open(RESULTS_MD, 'w', encoding='utf-8') as stream:
         stream.write(text)
     print(text)

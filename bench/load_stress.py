@@ -32,15 +32,12 @@ from node_session import planner_session
 
 TEST_DIR = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), 'test')
 CLIENT = os.path.join(TEST_DIR, 'reliability_client.py')
-OBSTACLES = ((-2.0, 0.5, 0.0), (0.0, -0.5, 0.0), (2.5, 0.0, 0.0))
-OTHER_OBSTACLES = ((-1.25, 1.0, 0.0), (0.75, -1.0, 0.0), (3.25, 0.5, 0.0))
-CONFIGURATIONS = (
-    ((-3.0, -2.0, 0.0), (-1.0, -2.5, 0.0), (1.0, -2.0, 0.0), (3.0, -2.5, 0.0)),
-    ((-2.0, -1.5, 0.0), (0.0, 1.5, 0.0), (1.5, -1.5, 0.0), (3.5, 1.0, 0.0)),
-    ((3.0, 3.0, 0.0), (1.0, 3.5, 0.0), (-1.0, 3.0, 0.0), (-3.0, 3.5, 0.0)),
-)
-STATES = (((-3.5, -3.0, 0.0), (-1.5, -3.5, 0.0), (1.5, -3.0, 0.0), (3.5, -3.5, 0.0)),
-          ((-3.0, 2.0, 0.0), (-1.0, 2.5, 0.0), (1.0, 2.0, 0.0), (3.0, 2.5, 0.0)))
+sys.path.insert(0, TEST_DIR)
+# The load scenario of test/test_reliability.py, the same client's (one place).
+from reliability_client import CONFIGURATIONS  # noqa: E402
+from reliability_client import OBSTACLES  # noqa: E402
+from reliability_client import OTHER_OBSTACLES  # noqa: E402
+from reliability_client import STATES  # noqa: E402
 PARAMETERS = {'obstacles': '[%s]' % ','.join(str(v) for p in OBSTACLES for v in p),
               'variant': 'spread', 'max_speed': '0.5', 'max_state_age': '0.0'}
 NOT_SENT = 'not sent to the client'

@@ -2,13 +2,17 @@
 ``make demo``: a simulated fleet, the planner and the executor, from plan to motion.
 
 1. starts ``fleet_sim``, ``planner_node`` and ``plan_executor`` (processes, one
-   parameter file: config/demo.yaml) in the namespace ``/demo``;
+   parameter file: config/demo.yaml, or config/demo_differential.yaml for
+   ``make demo DRIVE=differential``; ``--drive`` overrides both nodes' ``drive``)
+   in the namespace ``/demo``;
 2. plans from the robots' current state through config/demo_request.yaml
    (``use_current_state``);
 3. executes the plan through the ExecutePlan action;
-4. prints the executed duration and the simulator's true smallest gap;
-5. writes ``demo.mcap`` (the plan, every reference pose and odometry message,
-   at their arrival times) and ``demo.gif`` (the executed motion, top view).
+4. prints the executed duration, the simulator's true smallest gap, how far
+   each robot ended from its goal and from its requested heading;
+5. writes ``demo.mcap`` (the plan, every reference pose, cmd_vel and odometry
+   message, at their arrival times) and ``demo.gif`` (the executed motion, top
+   view), and reads the MCAP back to count cmd_vel messages with a non-zero linear.y.
 
 Ctrl-C stops everything cleanly. Exit 0 when the plan was executed, 1 otherwise.
 """
@@ -37,6 +41,7 @@ class Recorder:
         """Create the node, its executor and subscriptions (in /demo)."""
         import rclpy
         from geometry_msgs.msg import PoseStamped
+        from geometry_msgs.msg import Twist
         from nav_msgs.msg import Odometry
         from punctured_planner_interfaces.msg import Plan
         from rclpy.executors import SingleThreadedExecutor
@@ -63,6 +68,8 @@ class Recorder:
             self.node.create_subscription(Odometry, name + '/odom',
                                           self._odometry(name, keep('/demo/%s/odom' % name)),
                                           50)
+            self.node.create_subscription(Twist, name + '/cmd_vel',
+                                          keep('/demo/%s/cmd_vel' % name), 50)
         self.node.create_subscription(Float64, 'fleet_sim/min_gap',
                                       lambda msg: self.gap.append(msg.data), LATCHED)
 
@@ -126,10 +133,39 @@ def _run(recorder, request_path, mcap_path, gif_path):
     executed = result.executed_duration.sec + result.executed_duration.nanosec * 1e-9
     gap = recorder.gap[-1] if recorder.gap else float('nan')
     print('executed: %s in %.2f s (plan %.2f s); true smallest gap %.4f m; largest tracking '
-          'error %.3f m' % (result.error_msg or result.error_code, executed, planned, gap,
-                            max(result.max_tracking_errors, default=0.0)))
+          'error %.3f m (tolerance %.3f m)' % (
+              result.error_msg or result.error_code, executed, planned, gap,
+              max(result.max_tracking_errors, default=0.0), response.tracking_tolerance))
+    _print_arrival(recorder, response)
     _write(recorder, response, mcap_path, gif_path)
+    _check_commands(mcap_path)
     return 0 if result.error_code == 0 else 1
+
+
+def _print_arrival(recorder, response):
+    """Print each robot's distance to its goal and its heading error to its last pose."""
+    from .execution.unicycle import wrap
+    from .execution.unicycle import yaws
+    from .ros import conversions
+    for i, name in enumerate(recorder.names):
+        position, orientation = conversions.odometry_pose(recorder.odometry[name])
+        goal, wanted = conversions.path_arrays(response.paths[i])[1:3]
+        heading = float(wrap(yaws(orientation[None]) - yaws(wanted[-1:]))[0])
+        print('%s: %.4f m from its goal, heading %+.4f rad from the requested one'
+              % (name, np.linalg.norm(position - goal[-1]), heading))
+
+
+def _check_commands(mcap_path):
+    """Read the MCAP back; print how many cmd_vel messages it holds, how many with linear.y."""
+    from mcap.reader import make_reader
+    from mcap_ros2.decoder import DecoderFactory
+    with open(mcap_path, 'rb') as stream:
+        commands = [message for _, channel, _, message in make_reader(
+            stream, decoder_factories=[DecoderFactory()]).iter_decoded_messages()
+            if channel.topic.endswith('/cmd_vel')]
+    sideways = sum(1 for message in commands if message.linear.y != 0.0)
+    print('%s: %d cmd_vel messages, %d with a non-zero linear.y'
+          % (mcap_path, len(commands), sideways))
 
 
 def _write(recorder, response, mcap_path, gif_path):
@@ -155,14 +191,28 @@ def _write(recorder, response, mcap_path, gif_path):
     positions = np.array(frames)
     plan = next(m for t, m, _ in messages if t == '/demo/plan')
     planned = np.stack([conversions.path_arrays(p)[1][:, :2] for p in plan.paths], axis=1)
-    obstacles = np.array([(p.x, p.y) for p in plan.obstacles]).reshape(-1, 2)
-    from .execution import Bodies
-    bodies = Bodies(0.1, np.c_[obstacles, np.zeros(len(obstacles))], np.zeros(len(obstacles)))
+    bodies = conversions.plan_bodies(plan)
+    obstacles = bodies.obstacles[:, :2]
     gaps = np.minimum.accumulate([bodies.smallest_gap(np.c_[p, np.zeros(len(p))]).value
                                   for p in positions])
-    render_motion(gif_path, np.array(times), positions, planned, obstacles, 0.1, gaps,
+    render_motion(gif_path, np.array(times), positions, planned, obstacles,
+                  bodies.robot_radius, gaps,
                   title='make demo: plan %d executed' % plan.plan_id)
     print('wrote %s (%d messages) and %s' % (mcap_path, len(messages), gif_path))
+
+
+def _with_drive(params_path, drive, folder):
+    """Return a copy of a parameter file with fleet_sim's and plan_executor's drive set."""
+    # a -p override loses to the file's node sections, so the file itself is changed
+    with open(params_path, encoding='utf-8') as stream:
+        values = yaml.safe_load(stream)
+    for node in ('fleet_sim', 'plan_executor'):
+        section = values.setdefault('/**/' + node, {}).setdefault('ros__parameters', {})
+        section['drive'] = [drive]
+    path = os.path.join(folder, 'params.yaml')
+    with open(path, 'w', encoding='utf-8') as stream:
+        yaml.safe_dump(values, stream)
+    return path
 
 
 def main(argv=None):
@@ -172,15 +222,18 @@ def main(argv=None):
     parser.add_argument('--request', default=os.path.join(CONFIG, 'demo_request.yaml'))
     parser.add_argument('--mcap', default='demo.mcap')
     parser.add_argument('--gif', default='demo.gif')
+    parser.add_argument('--drive', choices=('holonomic', 'differential'),
+                        help="override fleet_sim's and plan_executor's drive (all robots)")
     args = parser.parse_args(argv)
     os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
     with open(args.params, encoding='utf-8') as stream:
         names = yaml.safe_load(stream)['/**']['ros__parameters']['robot_names']
     logs = tempfile.mkdtemp(prefix='punctured_planner_demo_')
     bin_dir = os.path.dirname(sys.executable)
+    params = args.params if args.drive is None else _with_drive(args.params, args.drive, logs)
     processes = [subprocess.Popen(
         [os.path.join(bin_dir, name), '--ros-args', '-r', '__ns:=/demo', '--params-file',
-         args.params], stdout=open(os.path.join(logs, name + '.log'), 'wb'),
+         params], stdout=open(os.path.join(logs, name + '.log'), 'wb'),
         stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL) for name in NODES]
     print('started %s (logs in %s)' % (', '.join(NODES), logs))
     recorder = None

@@ -24,6 +24,17 @@ import time
 
 import numpy as np
 
+# The load scenario of test/test_reliability.py and bench/load_stress.py: obstacles
+# and robot states alternate between two sets while the clients call.
+OBSTACLES = ((-2.0, 0.5, 0.0), (0.0, -0.5, 0.0), (2.5, 0.0, 0.0))
+OTHER_OBSTACLES = ((-1.25, 1.0, 0.0), (0.75, -1.0, 0.0), (3.25, 0.5, 0.0))
+CONFIGURATIONS = (
+    ((-3.0, -2.0, 0.0), (-1.0, -2.5, 0.0), (1.0, -2.0, 0.0), (3.0, -2.5, 0.0)),
+    ((-2.0, -1.5, 0.0), (0.0, 1.5, 0.0), (1.5, -1.5, 0.0), (3.5, 1.0, 0.0)),
+    ((3.0, 3.0, 0.0), (1.0, 3.5, 0.0), (-1.0, 3.0, 0.0), (-3.0, 3.5, 0.0)),
+)
+STATES = (((-3.5, -3.0, 0.0), (-1.5, -3.5, 0.0), (1.5, -3.0, 0.0), (3.5, -3.5, 0.0)),
+          ((-3.0, 2.0, 0.0), (-1.0, 2.5, 0.0), (1.0, 2.0, 0.0), (3.0, 2.5, 0.0)))
 CALL_TIMEOUT_SEC = 20.0
 DISCOVERY_TIMEOUT_SEC = 60.0
 RETRY_DEADLINE_SEC = 90.0

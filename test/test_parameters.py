@@ -64,6 +64,11 @@ def test_parameter_files(tmp_path):
                  'latencies': [0.1, 0.2]}, '2 values for 1 robots'),
     (FLEET_SIM, {'obstacles': [0.0] * 6, 'obstacle_radius': [1.0] * 3}, 'one each'),
     (FLEET_SIM, {'frame_id': ''}, 'frame_id must not be empty'),
+    (EXECUTOR, {'drive': ['tank']}, r"drive\[0\] = 'tank' is not one of holonomic"),
+    (EXECUTOR, {'drive': []}, 'one value or one per robot'),
+    (EXECUTOR, {'final_heading': 'any'}, 'final_heading'),
+    (FLEET_SIM, {'robot_names': ['a', 'b'], 'initial_positions': [0.0] * 6,
+                 'drive': ['differential'] * 3}, 'drive has 3 values for 2 robots'),
 ])
 def test_executor_and_simulator_validation_gives_reasons(table, values, words):
     with pytest.raises(ValueError, match=words):
@@ -94,3 +99,15 @@ def test_simulator_settings_become_the_fleet_physics():
     assert fleet.bodies.robot_radius == 0.2
     assert fleet.bodies.obstacle_radii.tolist() == [0.5]
     assert fleet.speed_factors.tolist() == [1.0, 0.5] and fleet.latencies is None
+    assert fleet.differential.tolist() == [False, False]
+    differential = FLEET_SIM.settings({
+        'robot_names': ['a', 'b'], 'initial_positions': [0.0] * 6,
+        'drive': ['holonomic', 'differential'], 'yaw_rate_limit': 1.9,
+        'max_acceleration': 1.0, 'max_yaw_acceleration': 4.0}).fleet()
+    assert differential.differential.tolist() == [False, True]
+    assert (differential.yaw_rate_limit, differential.max_acceleration,
+            differential.max_yaw_acceleration) == (1.9, 1.0, 4.0)
+    execution = EXECUTOR.settings({'drive': ['differential'], 'yaw_rate_limit': 1.9,
+                                   'final_heading': 'none'}).execution
+    assert execution.differential(3).tolist() == [True] * 3
+    assert execution.yaw_rate_limit == 1.9 and not execution.final_heading

@@ -7,7 +7,10 @@ odometry in another frame), a goal that waits for its plan, a full execution
 with a stale robot in the middle (the clock holds, then resumes), the true gap,
 the arrival, a cancel, and Ctrl-C of the executor in the middle of a goal (the
 goal ends STOPPED, exit 0, no traceback, robots stopped, the simulator serving
-on). The figures for 20 robots are in bench/.
+on). A second graph runs the same scene with differential-drive robots: only
+linear.x and angular.z commanded, the centres within the tolerance, each robot
+ending on its goal facing the requested heading. The figures for 20 robots are
+in bench/.
 """
 
 import signal
@@ -51,12 +54,22 @@ PARAMETERS = """
     speed_limit: 1.0
     discovery_timeout: 1.0
 """ % {'obstacles': OBSTACLES, 'start': [v for p in START for v in p], 'radius': RADIUS}
+# The same scene with TurtleBot-like differential robots (0.3 m/s, 1.9 rad/s).
+DIFFERENTIAL = PARAMETERS.replace('max_speed: 1.0', 'max_speed: 0.3').replace(
+    'speed_limit: 1.0', 'speed_limit: 0.3').replace(
+    'speed_factors: [0.5, 1.0, 1.0]', 'speed_factors: [0.8, 1.0, 1.0]').replace(
+    'velocity_noise: 0.05\n', 'velocity_noise: 0.05\n    drive: [differential]\n'
+    '    yaw_rate_limit: 1.9\n    max_acceleration: 1.0\n    max_yaw_acceleration: 8.0\n'
+).replace('discovery_timeout: 1.0\n', 'discovery_timeout: 1.0\n    drive: [differential]\n'
+          '    yaw_rate_limit: 1.9\n')
+# The headings the differential robots are asked to end in (rad).
+FINAL_YAWS = [np.pi / 2, np.pi, -np.pi / 2]
 
 
 class Graph:
     """The three processes and the test's client: action, service, parameters, topics."""
 
-    def __init__(self, client, env, tmp_path, namespace):
+    def __init__(self, client, env, tmp_path, namespace, parameters=PARAMETERS):
         """Start the nodes in one namespace and connect the client to them."""
         from geometry_msgs.msg import Twist
         from nav_msgs.msg import Odometry
@@ -67,7 +80,7 @@ class Graph:
         from rclpy.parameter_client import AsyncParameterClient
         from std_msgs.msg import Float64
         params = tmp_path / 'execution.yaml'
-        params.write_text(PARAMETERS, encoding='utf-8')
+        params.write_text(parameters, encoding='utf-8')
         self.client = client
         self.namespace = namespace
         self.processes = {
@@ -108,14 +121,25 @@ class Graph:
         """Return every process's output, for failure messages."""
         return '\n'.join('--- %s\n%s' % (n, p.log()) for n, p in self.processes.items())
 
-    def plan(self, configurations):
+    def plan(self, configurations, orientations=None):
         """Plan from the robots' current state; return the response."""
         from punctured_planner_interfaces.srv import PlanSequence
         from planner_helpers import pose_array
         request = PlanSequence.Request(use_current_state=True)
-        request.configurations = [pose_array(c) for c in configurations]
+        request.configurations = [pose_array(c, orientations=orientations)
+                                  for c in configurations]
         response = self.client.call(self.plan_sequence, request)
+        deadline = time.monotonic() + 10
+        while (response.error_code == PlanSequence.Response.NO_ROBOT_STATE
+               and time.monotonic() < deadline):
+            # the planner's own odometry subscriptions may match a little later than ours
+            self.client.spin_until(lambda: False, 0.2)
+            response = self.client.call(self.plan_sequence, request)
         assert response.error_code == 0, response.error_msg + self.logs()
+        # the latched plan reaches the executor on its own topic, maybe after the response
+        executor = self.processes['plan_executor']
+        assert self.client.spin_until(
+            lambda: 'plan %d:' % response.plan_id in executor.log(), 10), self.logs()
         return response
 
     def set_sim(self, **values):
@@ -159,8 +183,19 @@ class Graph:
 @pytest.fixture
 def graph(ros_client, ros_env, tmp_path):
     """Start the graph; stop every process after the test."""
+    yield from started_graph(ros_client, ros_env, tmp_path, 'pp_exec', PARAMETERS)
+
+
+@pytest.fixture
+def differential_graph(ros_client, ros_env, tmp_path):
+    """Start the graph of differential robots; stop every process after the test."""
+    yield from started_graph(ros_client, ros_env, tmp_path, 'pp_exec_dd', DIFFERENTIAL)
+
+
+def started_graph(ros_client, ros_env, tmp_path, tag, parameters):
+    """Yield a connected Graph; stop every process afterwards."""
     import os
-    started = Graph(ros_client, ros_env, tmp_path, '/pp_exec_%d' % os.getpid())
+    started = Graph(ros_client, ros_env, tmp_path, '/%s_%d' % (tag, os.getpid()), parameters)
     try:
         started.connect()
         yield started
@@ -257,3 +292,46 @@ def test_plan_to_motion_over_dds(graph):
         process = graph.processes[name]
         assert process.stop() == 0
         assert 'Traceback' not in process.log(), process.log()
+
+
+def test_differential_robots_over_dds(differential_graph):
+    """Only linear.x and angular.z reach the robots; within delta; on goal, facing FINAL_YAWS."""
+    from geometry_msgs.msg import Twist
+    from punctured_planner_interfaces.action import ExecutePlan
+    from scipy.spatial.transform import Rotation
+    graph, client = differential_graph, differential_graph.client
+    quaternions = Rotation.from_euler('z', np.array(FINAL_YAWS)[:, None]).as_quat()
+    response = graph.plan([GOAL], quaternions)
+    handle, _ = graph.send(response.plan_id)
+    result = graph.result(handle, timeout_sec=90)
+    assert result.error_code == ExecutePlan.Result.NONE, result.error_msg + graph.logs()
+    assert max(result.max_tracking_errors) <= response.tracking_tolerance
+    assert client.spin_until(lambda: graph.gap, 5)
+    assert graph.gap[-1] >= 0.0, graph.processes['fleet_sim'].log()
+    client.spin_until(lambda: False, 0.5)
+    assert np.linalg.norm(graph.positions() - GOAL, axis=1).max() <= 0.02
+    yaws = [Rotation.from_quat([o.pose.pose.orientation.x, o.pose.pose.orientation.y,
+                                o.pose.pose.orientation.z, o.pose.pose.orientation.w]
+                               ).as_euler('xyz')[2] for o in
+            (graph.odometry[name] for name in NAMES)]
+    assert np.abs(np.angle(np.exp(1j * (np.array(yaws) - FINAL_YAWS)))).max() <= 0.05
+    commands = [m for name in NAMES for _, m in graph.commands[name]]
+    assert len(commands) > 100 and any(m.angular.z != 0.0 for m in commands)
+    assert all(m.linear.y == 0.0 and m.linear.z == 0.0 for m in commands)
+    sim = graph.processes['fleet_sim']
+    assert 'linear.y' not in sim.log()
+    # a sideways command reaches r0 twice: ignored, and said once
+    publisher = client.node.create_publisher(Twist, graph.name('r0/cmd_vel'), 10)
+    for _ in range(2):
+        publisher.publish(Twist(linear=graph_vector(0.0, 0.2)))
+        client.spin_until(lambda: False, 0.2)
+    assert client.spin_until(lambda: 'linear.y' in sim.log(), 5), sim.log()
+    client.spin_until(lambda: False, 0.3)
+    assert sim.log().count('linear.y = 0.2 ignored') == 1, sim.log()
+    assert np.linalg.norm(graph.positions()[0] - GOAL[0]) <= 0.02
+
+
+def graph_vector(x, y):
+    """Return a geometry_msgs/Vector3 (x, y, 0)."""
+    from geometry_msgs.msg import Vector3
+    return Vector3(x=float(x), y=float(y))

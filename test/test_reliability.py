@@ -40,20 +40,15 @@ from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
 from punctured_planner.core.sections import SPREAD_LEGS
 import pytest
 from reliability_client import build_request
+from reliability_client import CONFIGURATIONS
+from reliability_client import OBSTACLES
+from reliability_client import OTHER_OBSTACLES
+from reliability_client import STATES
 import yaml
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-OBSTACLES = ((-2.0, 0.5, 0.0), (0.0, -0.5, 0.0), (2.5, 0.0, 0.0))
-OTHER_OBSTACLES = ((-1.25, 1.0, 0.0), (0.75, -1.0, 0.0), (3.25, 0.5, 0.0))
-CONFIGURATIONS = (
-    ((-3.0, -2.0, 0.0), (-1.0, -2.5, 0.0), (1.0, -2.0, 0.0), (3.0, -2.5, 0.0)),
-    ((-2.0, -1.5, 0.0), (0.0, 1.5, 0.0), (1.5, -1.5, 0.0), (3.5, 1.0, 0.0)),
-    ((3.0, 3.0, 0.0), (1.0, 3.5, 0.0), (-1.0, 3.0, 0.0), (-3.0, 3.5, 0.0)),
-)
-STATES = (((-3.5, -3.0, 0.0), (-1.5, -3.5, 0.0), (1.5, -3.0, 0.0), (3.5, -3.5, 0.0)),
-          ((-3.0, 2.0, 0.0), (-1.0, 2.5, 0.0), (1.0, 2.0, 0.0), (3.0, 2.5, 0.0)))
 PARAMETERS = {
     'frame_id': 'map', 'dimension': 2, 'plane_z': 0.0, 'robot_count': 0,
     'obstacles': [v for point in OBSTACLES for v in point], 'variant': 'spread',

@@ -230,7 +230,10 @@ def _pruned_robot_minimum(positions, legs, bound):
         a, b = _sweep_pairs(positions[leg], positions[leg + 1], bound)
         if a.size == 0:
             continue
-        distance, _, pair, fraction = _pairs_minimum(positions, np.array([leg]), a, b)
+        # Only the leg's two breakpoints: the whole motion made contiguous per leg costs
+        # O(V) each, O(V^2) in all.
+        distance, _, pair, fraction = _pairs_minimum(positions[leg:leg + 2], np.array([0]),
+                                                     a, b)
         if distance < best[0]:
             best = (distance, int(leg), int(a[pair]), int(b[pair]), fraction)
     return best

@@ -21,29 +21,28 @@ smallest robot-pillar slack; each knot's total move in the block is split into
 the fleet's common translation (which robot pairs do not feel) and each
 robot's own part, each clipped to its caps and to a fixed step. Gap distance
 is 1-Lipschitz in each robot's position, so no gap falls below g0 (the caps
-lemma). Every quantity is a continuous function of the input; pairs are left
-out only where their cap term provably exceeds the step (so leaving them out
-changes nothing), and the number of blocks, sweeps and knots is fixed, so the
-map stays continuous on every domain (doc/design.md section 14).
+lemma). Every pair is evaluated, so no pair enters or leaves the checked set;
+every quantity is a continuous function of the input, and the number of
+blocks, sweeps and knots is fixed, so the map stays continuous on every domain
+(doc/design.md section 14).
 """
 
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from .certificate import certify, segment_minimum
 
 # Knots per segment: the field is piecewise linear on the j / KNOTS fractions.
 KNOTS = 64
-# A block computes the caps once (the costly part: the exact slack of every pair near
-# enough to matter), then runs SWEEPS red-black sweeps of over-relaxed smoothing
+# A block computes the caps once (the costly part: the exact slack of every pair
+# near enough to matter), then runs SWEEPS red-black sweeps of over-relaxed smoothing
 # (successive over-relaxation: O(KNOTS) sweeps where plain smoothing, like diffusion,
 # needs O(KNOTS^2)), each knot's total move in the block clipped to its caps. Fresh caps
 # let robots use the room they made, so more blocks shorten more; but a block's caps
 # follow the motion (a pillar cap moves by up to half of what the motion moves), so
 # each block can amplify a change of input, and BLOCKS bounds that (measured: a 1e-7
-# change moves the refined motion 5 - 22x that, the construction's 2 - 4x).
+# change moves the refined motion 3 - 34x that, the construction's 2 - 6x).
 BLOCKS, SWEEPS = 12, 6
 # A block's cost grows like k^2 (all pairs near each other somewhere): beyond FULL_ROBOTS
 # robots the blocks fall as FULL_ROBOTS / k, and beyond MAX_ROBOTS none is run (the
@@ -61,8 +60,9 @@ PAIR_SHARE, PILLAR_SHARE = 0.25, 0.5
 # (4: the smallest pair slack itself; more would make the caps steep, and continuity
 # weaker, for nothing but rounding).
 _TRANSLATION = 4.0
-# Up to this many robots every pair is checked on every interval (pruning costs more).
-_ALL_PAIRS = 24
+# Entries (coordinate x leg x robot x robot or pillar) of the slack arrays computed at
+# once.
+_ENTRIES = 1 << 21
 
 
 @dataclass(frozen=True, eq=False)
@@ -160,117 +160,79 @@ class _Knots:
         return (1.0 - f) * values[self.interval] + f * values[self.interval + 1]
 
 
-def _enclosing_balls(motion, knots):
-    """
-    Return (centres (N - 1, k, d), radii (N - 1, k)): a ball holding each robot per interval.
-
-    The centre is the midpoint of the robot's positions at the interval's two
-    knots; the radius the farthest breakpoint from it, so the whole piece of
-    motion (linear between breakpoints) lies in the ball. Both are continuous
-    in the motion.
-    """
-    centres = 0.5 * (motion[knots.points[:-1]] + motion[knots.points[1:]])
-    owner = np.minimum(knots.interval, centres.shape[0] - 1)
-    distance = np.sqrt(((motion - centres[owner]) ** 2).sum(axis=2))
-    radii = np.maximum.reduceat(distance, knots.points[:-1], axis=0)
-    # reduceat stops short of each interval's end knot, which starts the next interval.
-    end = np.sqrt(((motion[knots.points[1:]] - centres) ** 2).sum(axis=2))
-    return centres, np.maximum(radii, end)
-
-
-def _pair_candidates(centres, radii, reach):
-    """
-    Return (interval, a, b), a < b, of the robot pairs whose balls come within reach.
-
-    Few robots: every pair. Many: one tree over all (interval, robot) balls,
-    intervals set far apart along an extra axis. A pair left out is more than
-    reach apart over its whole interval.
-    """
-    intervals, k, d = centres.shape
-    if k <= _ALL_PAIRS:
-        a, b = np.triu_indices(k, 1)
-        interval = np.repeat(np.arange(intervals), a.size)
-        a, b = np.tile(a, intervals), np.tile(b, intervals)
-    else:
-        flat = centres.reshape(-1, d)
-        span = float(np.ptp(flat, axis=0).max()) + 2 * float(radii.max()) + reach + 1.0
-        apart = (np.repeat(np.arange(intervals), k) * 2 * span)[:, None]
-        found = cKDTree(np.concatenate([flat, apart], axis=1)).query_pairs(
-            reach + 2 * float(radii.max()), output_type='ndarray').reshape(-1, 2)
-        interval, a = np.divmod(found.min(axis=1), k)
-        b = found.max(axis=1) % k
-    distance = np.sqrt(((centres[interval, a] - centres[interval, b]) ** 2).sum(axis=1))
-    near = distance - radii[interval, a] - radii[interval, b] < reach
-    return interval[near], a[near], b[near]
-
-
-def _interval_legs(knots, interval):
-    """Return (legs, owner): the union legs of each listed interval, and the list entry."""
-    count = (knots.points[1:] - knots.points[:-1])[interval]
-    owner = np.repeat(np.arange(interval.size), count)
-    first = np.repeat(knots.points[interval] - (np.cumsum(count) - count), count)
-    return first + np.arange(owner.size), owner
-
-
-def _leg_minima(planes, legs, a, b):
-    """
-    Return the smallest |x_a - x_b| over each leg, exactly.
-
-    planes is the motion coordinate first (d, U, k); b is robots, or a fixed
-    point per entry (d, entries).
-    """
-    start = planes[:, legs, a] - (planes[:, legs, b] if b.ndim == 1 else b)
-    end = planes[:, legs + 1, a] - (planes[:, legs + 1, b] if b.ndim == 1 else b)
-    end -= start
-    squared, _ = segment_minimum(start, end)
+def _length(vectors):
+    """Return the lengths (...) of vectors (..., d); a sum per coordinate is faster."""
+    squared = vectors[..., 0] * vectors[..., 0]
+    for axis in range(1, vectors.shape[-1]):
+        squared = squared + vectors[..., axis] * vectors[..., axis]
     return np.sqrt(squared)
+
+
+def _interval_minima(planes, knots, pillars=None):
+    """
+    Return (N - 1, k, m) the exact smallest distance over each knot interval, densely.
+
+    From every robot to every robot (m = k, the diagonal +inf) or, with pillars
+    (m, d), to every pillar: the closed form on every leg of the union, then
+    the minimum over each interval's legs. planes is the motion coordinate
+    first (d, U, k). Dense arrays over a few hundred legs cost less than
+    choosing pairs would; a run of whole intervals at a time bounds the
+    temporaries (the grouping does not change any value).
+    """
+    d, _, k = planes.shape
+    # Robot pairs a < b only (np.take keeps the pairs last and contiguous), then mirrored.
+    a, b = np.triu_indices(k, 1)
+    width = a.size if pillars is None else k * pillars.shape[0]
+    points = knots.points
+    minima = np.empty((points.size - 1, width))
+    legs = max(1, _ENTRIES // (d * max(width, 1)))
+    first = 0
+    while first < minima.shape[0]:
+        last = int(np.searchsorted(points, points[first] + legs, side='right')) - 1
+        last = min(max(last, first + 1), minima.shape[0])
+        piece = planes[:, points[first]:points[last] + 1]
+        if pillars is None:
+            relative = np.take(piece, a, axis=2) - np.take(piece, b, axis=2)
+        else:
+            relative = (piece[:, :, :, None] - pillars.T[:, None, None, :]).reshape(
+                d, piece.shape[1], width)
+        squared, _ = segment_minimum(relative[:, :-1], relative[:, 1:] - relative[:, :-1])
+        minima[first:last] = np.sqrt(np.minimum.reduceat(
+            squared, points[first:last] - points[first], axis=0))
+        first = last
+    if pillars is not None:
+        return minima.reshape(minima.shape[0], k, pillars.shape[0])
+    result = np.full((minima.shape[0], k, k), np.inf)
+    result[:, a, b] = minima
+    result[:, b, a] = minima
+    return result
 
 
 class _Caps:
     """
     Each robot's caps at every knot: (N, k) for its robot pairs and for the pillars.
 
-    From the exact slack (closed form per leg) of robot pairs and robot-pillar
-    pairs over each knot interval: a quarter (PAIR_SHARE) of the smallest pair
-    slack, half (PILLAR_SHARE) of the smallest pillar slack, over the two
-    intervals each knot's hat covers; 0 at the configurations. A pair whose
-    enclosing balls already keep a slack of 4 step is left out: its cap term
-    would be at least step (2 step for a pillar), which the block's caps never
-    exceed, so leaving it out changes nothing (design, 14).
+    From the exact slack (closed form per leg) of every robot pair and every
+    robot-pillar pair over each knot interval: a quarter (PAIR_SHARE) of the
+    smallest pair slack, half (PILLAR_SHARE) of the smallest pillar slack, over
+    the two intervals each knot's hat covers, at most step (2 step for a
+    pillar); 0 at the configurations (design, 14).
     """
 
     def __init__(self, motion, knots, bodies, step):
         """Compute the caps for the motion at the union's breakpoints (U, k, d)."""
-        centres, radii = _enclosing_balls(motion, knots)
-        intervals, k, d = centres.shape
+        intervals, k = knots.points.size - 1, motion.shape[1]
         planes = np.ascontiguousarray(np.moveaxis(motion, 2, 0))
         floor = bodies.margin + bodies.rounding
-        prune = 4 * step
         pair = np.full((intervals, k), step)
         if k > 1:
-            radius = bodies.radii[0]
-            interval, a, b = _pair_candidates(centres, radii, prune + 2 * radius + floor)
-            if interval.size:
-                legs, owner = _interval_legs(knots, interval)
-                slack = np.full(interval.size, np.inf)
-                np.minimum.at(slack, owner, _leg_minima(planes, legs, a[owner], b[owner]))
-                share = PAIR_SHARE * np.maximum(slack - 2 * radius - floor, 0.0)
-                np.minimum.at(pair, (interval, a), share)
-                np.minimum.at(pair, (interval, b), share)
+            slack = _interval_minima(planes, knots).min(axis=2) - 2 * bodies.radii[0] - floor
+            pair = np.minimum(pair, PAIR_SHARE * np.maximum(slack, 0.0))
         pillar = np.full((intervals, k), 2 * step)
         if len(bodies.obstacles):
-            pillars = bodies.obstacles
-            offsets = bodies.radii[:k][None, :, None] + bodies.radii[None, None, k:] + floor
-            ball = (np.sqrt(((centres[:, :, None, :] - pillars[None, None]) ** 2).sum(axis=3))
-                    - radii[:, :, None] - offsets)
-            interval, a, q = np.nonzero(ball < prune)
-            if interval.size:
-                legs, owner = _interval_legs(knots, interval)
-                slack = np.full(interval.size, np.inf)
-                np.minimum.at(slack, owner,
-                              _leg_minima(planes, legs, a[owner], pillars[q[owner]].T))
-                share = PILLAR_SHARE * np.maximum(slack - offsets[0, a, q], 0.0)
-                np.minimum.at(pillar, (interval, a), share)
+            offsets = bodies.radii[:k, None] + bodies.radii[None, k:] + floor
+            slack = (_interval_minima(planes, knots, bodies.obstacles) - offsets).min(axis=2)
+            pillar = np.minimum(pillar, PILLAR_SHARE * np.maximum(slack, 0.0))
         self.pair, self.pillar = _knot_caps(pair), _knot_caps(pillar)
 
 
@@ -284,7 +246,7 @@ def _knot_caps(bound):
 
 def _clipped(move, caps):
     """Return the moves (..., d) scaled down to lengths <= caps (...); zero at cap 0."""
-    length = np.sqrt((move * move).sum(axis=-1))
+    length = _length(move)
     over = length > caps
     scale = np.where(over, caps / np.where(over, length, 1.0), 1.0)
     return move * scale[..., None]
@@ -319,7 +281,7 @@ class _Block:
         common is the fleet's mean, clipped; own what each robot still wants, clipped.
         """
         common = _clipped(wanted.mean(axis=1), self.common_cap)
-        left = self.pillar - np.sqrt((common * common).sum(axis=1))[:, None]
+        left = self.pillar - _length(common)[:, None]
         own = _clipped(wanted - common[:, None], np.minimum(np.minimum(self.pair, left),
                                                             self.step))
         return common, own

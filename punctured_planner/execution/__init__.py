@@ -7,15 +7,17 @@ robot may have while the bodies still cannot touch, ``reference`` the robots'
 reference positions and velocities at a plan time, ``bodies`` the surface gaps
 of disc robots and obstacles, and ``execution`` one control step: advance the
 shared clock as far as the robots' errors allow, then track the reference with
-feed-forward and saturated feedback. The ``plan_executor`` node is a thin
+feed-forward and saturated feedback; ``unicycle`` is the tracking law of
+differential-drive robots (a point ahead of the centre, turns in place, the
+clock's caps before corners). The ``plan_executor`` node is a thin
 adapter around :class:`Execution`; the simulated fleet (``sim``) uses
 ``bodies`` for its true gap.
 """
 
 from .bodies import Bodies, Gap
-from .execution import Execution, ExecutionSettings, Step
+from .execution import DRIVES, Execution, ExecutionSettings, Step
 from .reference import Reference
 from .tolerance import clock_rate, tracking_tolerance
 
-__all__ = ['Bodies', 'Execution', 'ExecutionSettings', 'Gap', 'Reference', 'Step',
+__all__ = ['Bodies', 'DRIVES', 'Execution', 'ExecutionSettings', 'Gap', 'Reference', 'Step',
            'clock_rate', 'tracking_tolerance']

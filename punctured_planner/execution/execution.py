@@ -13,20 +13,33 @@ Each step (doc/design.md section 13; msg_docs/ExecutePlan.md):
    limit: v = sat(rate x reference'(s) + gain x (reference(s) - position)).
    A stale robot gets 0.
 
+Differential robots (``drive``) track through :mod:`.unicycle` instead: the
+clock sees the bound E = |reference - P| + e of each one's centre error, is
+capped so each can follow its reference's direction and slows before the
+corners ahead; a robot facing too far from where its reference goes turns in
+place while its reference stands still. After the end each parks its centre on
+its last position, then turns in place to its last orientation (``final_heading``).
+
 The execution is finished once s reached the plan's end and every robot is
-within ``goal_tolerance`` of its last configuration.
+within ``goal_tolerance`` of its last configuration (and every differential
+robot has been within unicycle.HEADING_TOLERANCE of its final heading for
+unicycle.SETTLE seconds).
 """
 
 from dataclasses import dataclass
 
 import numpy as np
 
+from . import unicycle
 from .bodies import Bodies
 from .reference import Reference
 from .tolerance import clock_rate
 
 # Longest step the clock takes at once (s): a stalled control loop does not jump ahead.
 MAX_STEP = 0.2
+HOLONOMIC = 'holonomic'
+DIFFERENTIAL = 'differential'
+DRIVES = (HOLONOMIC, DIFFERENTIAL)
 
 
 @dataclass(frozen=True)
@@ -39,6 +52,21 @@ class ExecutionSettings:
     hold_fraction: float = 0.6
     goal_tolerance: float = 0.01
     shared_clock: bool = True
+    drive: tuple = (HOLONOMIC,)         # one value, or one per robot in plan order
+    yaw_rate_limit: float = 1.0         # rad/s, differential robots
+    final_heading: bool = True          # differential robots end facing their last pose
+
+    def differential(self, robot_count: int) -> np.ndarray:
+        """Return the (k,) mask of differential robots; ValueError if drive does not fit k."""
+        return differential_mask(self.drive, robot_count)
+
+
+def differential_mask(drive: tuple, robot_count: int) -> np.ndarray:
+    """Return the (k,) mask of drive's differential robots (one value, or one per robot)."""
+    if len(drive) not in (1, robot_count):
+        raise ValueError('drive has %d values for %d robots (one, or one per robot)'
+                         % (len(drive), robot_count))
+    return np.broadcast_to(np.asarray(drive) == DIFFERENTIAL, robot_count).copy()
 
 
 @dataclass(frozen=True)
@@ -52,6 +80,9 @@ class Step:
     velocities: np.ndarray      # (k, 3) commanded velocities, planning frame
     errors: np.ndarray          # (k,) tracking errors measured this step (m)
     finished: bool
+    differential: np.ndarray    # (k,) robots commanded by forward speed and yaw rate
+    forward: np.ndarray         # (k,) differential robots' forward speeds (m/s), else 0
+    yaw_rates: np.ndarray       # (k,) differential robots' yaw rates (rad/s), else 0
 
 
 def saturate(velocities: np.ndarray, limit: float) -> np.ndarray:
@@ -66,7 +97,7 @@ class Execution:
 
     def __init__(self, reference: Reference, tolerance: float, settings: ExecutionSettings,
                  bodies: Bodies | None = None):
-        """Start at plan time 0 with no error measured yet."""
+        """Start at plan time 0 with no error measured yet; ValueError if drive does not fit."""
         self.reference = reference
         self.tolerance = float(tolerance)
         self.settings = settings
@@ -74,34 +105,150 @@ class Execution:
         self.plan_time = 0.0
         self.max_errors = np.zeros(reference.robot_count)
         self.min_gap = np.inf
+        self.differential = settings.differential(reference.robot_count)
+        self.lead = unicycle.lead(self.tolerance, settings.slow_fraction,
+                                  settings.hold_fraction)
+        self.steering = unicycle.steering(self.lead)
+        self.corners = unicycle.Corners(reference.seconds, reference.positions)
+        self.final_yaws = unicycle.yaws(reference.orientation(reference.duration))
+        self.turning = np.zeros(reference.robot_count, dtype=bool)
+        # robots driving backward: their lead point is e behind, their 'heading' theta + pi
+        self.reverse = np.zeros(reference.robot_count, dtype=bool)
+        self.settled = 0.0     # seconds every final heading has been reached for
 
-    def step(self, dt: float, positions: np.ndarray, stale: np.ndarray) -> Step:
+    def step(self, dt: float, positions: np.ndarray, stale: np.ndarray,
+             orientations: np.ndarray | None = None) -> Step:
         """
         Advance by dt seconds for robot positions (k, 3) and stale flags (k,); return the Step.
 
-        The positions of stale robots are not used (their errors count as 0 this step).
+        orientations (k, 4) are the robots' quaternions (None: identity); the
+        differential robots' headings are their yaws. The positions of stale
+        robots are not used (their errors count as 0 this step).
         """
         s = self.settings
         stale = np.asarray(stale, dtype=bool)
-        errors = np.linalg.norm(self.reference.position(self.plan_time) - positions, axis=1)
+        k = self.reference.robot_count
+        angles = (np.zeros(k) if orientations is None else unicycle.yaws(orientations))
+        reference_now = self.reference.position(self.plan_time)
+        errors = np.linalg.norm(reference_now - positions, axis=1)
         errors[stale] = 0.0
         self.max_errors = np.maximum(self.max_errors, errors)
         if not stale.any():
             self.min_gap = min(self.min_gap, self.bodies.smallest_gap(positions).value)
+        differential = self.differential & ~stale
+        # the clock watches each differential robot's bound E of its centre error
+        lead_points = unicycle.lead_points(positions, self._driving(angles), self.lead)
+        watched = np.where(differential, np.linalg.norm(reference_now - lead_points, axis=1)
+                           + self.lead, errors)
+        dt = min(max(dt, 0.0), MAX_STEP)
+        alpha = self._update_turns(angles, watched)
+        driving = self._driving(angles)
         if not s.shared_clock:
             rate = 1.0
         elif stale.any():
             rate = 0.0
         else:
-            rate = clock_rate(errors, self.tolerance, s.slow_fraction, s.hold_fraction)
+            rate = min(clock_rate(watched, self.tolerance, s.slow_fraction, s.hold_fraction),
+                       self._differential_cap(alpha, dt))
         duration = self.reference.duration
-        self.plan_time = min(duration, self.plan_time + rate * min(max(dt, 0.0), MAX_STEP))
+        self.plan_time = min(duration, self.plan_time + rate * dt)
         target = self.reference.position(self.plan_time)
         command = rate * self.reference.velocity(self.plan_time) + s.gain * (target - positions)
         velocities = saturate(command, s.speed_limit)
+        unicycle_command = self._unicycle(rate, target, positions, angles, driving, alpha)
+        forward = np.where(differential, unicycle_command.forward, 0.0)
+        yaw_rates = np.where(differential, unicycle_command.yaw_rate, 0.0)
+        velocities = np.where(differential[:, None],
+                              forward[:, None] * unicycle.headings(angles), velocities)
         velocities[stale] = 0.0
-        finished = bool(self.plan_time >= duration and not stale.any()
-                        and np.all(np.linalg.norm(target - positions, axis=1)
-                                   <= s.goal_tolerance))
+        arrived = bool(self.plan_time >= duration and not stale.any() and np.all(
+            np.linalg.norm(target - positions, axis=1) <= s.goal_tolerance))
+        finished = self._settled(arrived, angles, dt) and arrived
         return Step(self.plan_time, rate, target, self.reference.orientation(self.plan_time),
-                    velocities, errors, finished)
+                    velocities, errors, finished, self.differential.copy(), forward, yaw_rates)
+
+    def _settled(self, arrived: bool, angles: np.ndarray, dt: float) -> bool:
+        """Return whether every differential robot has faced its final heading for SETTLE s."""
+        if not (self.settings.final_heading and self.differential.any()):
+            return True
+        facing = np.abs(unicycle.wrap(self.final_yaws - angles))[self.differential]
+        self.settled = (self.settled + dt if arrived and np.all(
+            facing <= unicycle.HEADING_TOLERANCE) else 0.0)
+        return self.settled >= unicycle.SETTLE
+
+    def _update_turns(self, angles: np.ndarray, watched: np.ndarray) -> np.ndarray:
+        """
+        Start and end the differential robots' turns in place; return their misalignments.
+
+        A turn starts where the driving heading is more than TURN_ANGLE from
+        the direction the reference moves in (or moves next) and E <= hold
+        delta - 2e, so that E stays below hold delta (it grows by at most 2e
+        while the centre stands); it ends within ALIGNED of that direction.
+        Where driving the other way round needs less turning, the robot
+        switches direction first: its lead point jumps by at most 2e, the same
+        bound.
+        """
+        s = self.settings
+        directions, _ = self.corners.upcoming(self.plan_time)
+        alpha = unicycle.misalignment(self._driving(angles), directions)
+        may_turn = watched <= s.hold_fraction * self.tolerance - 2.0 * self.lead
+        flip = (self.differential & may_turn & (np.abs(alpha) > unicycle.TURN_ANGLE)
+                & (np.abs(unicycle.wrap(alpha + np.pi)) < np.abs(alpha)))
+        self.reverse ^= flip
+        alpha = np.where(flip, unicycle.wrap(alpha + np.pi), alpha)
+        start = (np.abs(alpha) > unicycle.TURN_ANGLE) & may_turn
+        self.turning = (self.differential & (self.turning | start)
+                        & (np.abs(alpha) > unicycle.ALIGNED)
+                        & (self.plan_time < self.reference.duration))
+        return alpha
+
+    def _driving(self, angles: np.ndarray) -> np.ndarray:
+        """Return the driving headings: the yaw, or yaw + pi for robots driving backward."""
+        return angles + np.pi * self.reverse
+
+    def _differential_cap(self, alpha: np.ndarray, dt: float) -> float:
+        """
+        Return the largest clock rate the differential robots allow this step.
+
+        A turning robot holds the clock unless its reference stands still for
+        the whole step; a following one caps it so its lead point can follow
+        the reference's direction (creep_rate); every one slows into its corners.
+        """
+        if not self.differential.any():
+            return 1.0
+        s_now, settings = self.plan_time, self.settings
+        _, still_until = self.corners.upcoming(s_now)
+        speeds = np.linalg.norm(self.reference.velocity(s_now), axis=1)
+        limit = settings.yaw_rate_limit
+        room = np.clip((still_until - s_now) / dt, 0.0, 1.0) if dt > 0 else np.ones(len(alpha))
+        caps = np.where(self.turning, room,
+                        unicycle.creep_rate(alpha, speeds, self.steering, limit))
+        caps = np.minimum(caps, self.corners.corner_caps(s_now, self.steering, limit))
+        return float(np.min(caps[self.differential], initial=1.0))
+
+    def _unicycle(self, rate: float, target: np.ndarray, positions: np.ndarray,
+                  angles: np.ndarray, driving: np.ndarray,
+                  alpha: np.ndarray) -> unicycle.UnicycleCommand:
+        """
+        Return every robot's unicycle command: follow, turn, park or face the final pose.
+
+        angles are the yaws, driving the driving headings (yaw + pi backward).
+        """
+        s = self.settings
+        if self.plan_time >= self.reference.duration:
+            command = unicycle.park(positions, angles, target, s.gain, s.speed_limit,
+                                    s.yaw_rate_limit)
+            parked = np.linalg.norm(target - positions, axis=1) <= 0.5 * s.goal_tolerance
+            final = (unicycle.turn(unicycle.wrap(self.final_yaws - angles), s.yaw_rate_limit)
+                     if s.final_heading else np.zeros(len(angles)))
+            return unicycle.UnicycleCommand(np.where(parked, 0.0, command.forward),
+                                            np.where(parked, final, command.yaw_rate))
+        lead_points = unicycle.lead_points(positions, driving, self.lead)
+        desired = rate * self.reference.velocity(self.plan_time) + s.gain * (target
+                                                                             - lead_points)
+        command = unicycle.follow(desired, driving, self.steering, s.speed_limit,
+                                  s.yaw_rate_limit)
+        forward = np.where(self.reverse, -command.forward, command.forward)
+        return unicycle.UnicycleCommand(
+            np.where(self.turning, 0.0, forward),
+            np.where(self.turning, unicycle.turn(alpha, s.yaw_rate_limit), command.yaw_rate))

@@ -7,13 +7,15 @@ each robot's latest ``<robot>/odom``, and serves the ``execute_plan`` action
 (ExecutePlan). A control timer at ``control_rate`` runs one Execution step for
 the active goal and publishes ``<robot>/cmd_vel`` (mode ``velocity``;
 geometry_msgs/Twist in the robot's body frame, rotated from the planning frame
-by its odometry orientation) and ``<robot>/reference_pose`` (PoseStamped at
-the shared clock, both modes).
+by its odometry orientation; for a differential robot (``drive``) only
+linear.x and angular.z, linear.y exactly 0) and ``<robot>/reference_pose``
+(PoseStamped at the shared clock, both modes).
 
 Goal life: the plan is looked up (``NO_PLAN`` once ``PLAN_WAIT_SEC`` passed
 without it: the planner answers before it publishes, so a goal may name a plan
-still on its way), its tolerance checked
-(``UNSAFE_PLAN``); the executor then waits up to ``discovery_timeout`` for
+still on its way), its tolerance checked (``UNSAFE_PLAN``), ``drive`` checked
+against its robots (``UNKNOWN_ROBOTS``: neither one value nor one per robot);
+the executor then waits up to ``discovery_timeout`` for
 fresh odometry of every robot (``UNKNOWN_ROBOTS``) in the plan's frame
 (``FRAME_MISMATCH``); then it runs until every robot has arrived (``NONE``),
 a cancel (``CANCELED``: every robot is sent zero velocity from the cancel
@@ -47,10 +49,12 @@ from rclpy.task import Future
 from scipy.spatial.transform import Rotation
 
 from ..execution import Execution
+from ..execution.execution import differential_mask
 from ..ros import conversions
 from ..ros.goals import fleet_state
 from ..ros.goals import FleetState
 from ..ros.goals import KnownPlan
+from ..ros.goals import Lookup
 from ..ros.goals import PlanStore
 from ..ros.parameters import NodeParameters
 from ..ros.qos import COMMANDS
@@ -179,6 +183,8 @@ class PlanExecutor(Node):
             found = await self._wait_for_plan(goal.request.plan_id)
         run = None
         if found.code == Result.NONE:
+            found = self._check_drive(found)
+        if found.code == Result.NONE:
             run = Run(goal, found.plan, self.get_clock().now().nanoseconds)
             self._run = run
             result = await run.done
@@ -215,6 +221,15 @@ class PlanExecutor(Node):
             self.destroy_timer(timer)
             self._plan_waits.remove(entry)
         return self._plans.lookup(plan_id, self.resolve_topic_name('plan'))
+
+    def _check_drive(self, found: Lookup) -> Lookup:
+        """Return found, or UNKNOWN_ROBOTS when drive has neither one value nor one per robot."""
+        try:
+            differential_mask(self._settings.drive, len(found.plan.names))
+        except ValueError as error:
+            return Lookup(found.plan, Result.UNKNOWN_ROBOTS, 'plan %d has robots %s: %s'
+                          % (found.plan.plan_id, ', '.join(found.plan.names), error))
+        return found
 
     def _finish(self, run, code, message):
         """End a run with a result (once); the goal's coroutine resumes with it."""
@@ -258,7 +273,7 @@ class PlanExecutor(Node):
         if run.execution is None and not self._start(run, state, now):
             return
         step = run.execution.step((now - run.last_ns) * 1e-9, state.positions,
-                                  state.stale_mask)
+                                  state.stale_mask, state.orientations)
         run.last_ns = now
         self._log_stale(run, state, step.plan_time)
         self._publish_step(plan, step, state, now)
@@ -300,7 +315,11 @@ class PlanExecutor(Node):
         run.stale = state.stale
 
     def _publish_step(self, plan, step, state, now_ns):
-        """Publish every robot's reference pose and, in mode velocity, its body-frame command."""
+        """
+        Publish every robot's reference pose and, in mode velocity, its body-frame command.
+
+        A differential robot gets (forward, 0, 0) and its yaw rate: never a sideways part.
+        """
         header = conversions.header(plan.frame_id, now_ns)
         body = Rotation.from_quat(state.orientations).apply(step.velocities, inverse=True)
         velocity_mode = self._settings.mode == 'velocity'
@@ -308,7 +327,12 @@ class PlanExecutor(Node):
             link = self._links[name]
             link.reference.publish(conversions.pose_stamped(header, step.positions[i],
                                                             step.orientations[i]))
-            if velocity_mode:
+            if not velocity_mode:
+                continue
+            if step.differential[i]:
+                link.cmd_vel.publish(conversions.twist((step.forward[i], 0.0, 0.0),
+                                                       step.yaw_rates[i]))
+            else:
                 link.cmd_vel.publish(conversions.twist(body[i]))
 
     def _stop_robots(self, names):

@@ -1,5 +1,5 @@
 """
-The fleet_sim node: simulated holonomic disc robots over DDS, for tests, demos and users.
+The fleet_sim node: simulated disc robots over DDS, holonomic or differential, for tests and demos.
 
 A thin adapter around :class:`punctured_planner.sim.Fleet`: ``<robot>/cmd_vel``
 (geometry_msgs/Twist) in; ``<robot>/odom`` (nav_msgs/Odometry), ``robot_states``
@@ -7,8 +7,10 @@ A thin adapter around :class:`punctured_planner.sim.Fleet`: ``<robot>/cmd_vel``
 smallest surface gap between bodies so far, latched) out, every step at
 ``rate``. Every new contact is logged with the bodies and the gap. Robots
 named in ``muted_robots`` keep moving but publish no odometry (a dropped link),
-settable at run time. Nothing to do before teardown: a simulated robot without
-commands stops by itself.
+settable at run time. A differential robot (``drive``) takes only linear.x and
+angular.z, like a real base: a non-zero linear.y is ignored, and logged once per
+robot; its odometry carries its heading (yaw) and its body-frame twist.
+Nothing to do before teardown: a simulated robot without commands stops by itself.
 """
 
 import sys
@@ -45,6 +47,7 @@ class FleetSim(Node):
         self._start_ns = self.get_clock().now().nanoseconds
         self._last_ns = self._start_ns
         self._odometry = []
+        self._sideways_logged: set[int] = set()
         for i, name in enumerate(self._names):
             self.create_subscription(Twist, name + '/cmd_vel',
                                      lambda msg, i=i: self._on_command(i, msg), COMMANDS)
@@ -65,11 +68,18 @@ class FleetSim(Node):
 
     def _on_command(self, robot, msg):
         velocity = np.array([msg.linear.x, msg.linear.y, msg.linear.z])
-        if not np.all(np.isfinite(velocity)):
+        if not np.all(np.isfinite(velocity)) or not np.isfinite(msg.angular.z):
             self.get_logger().warning('%s/cmd_vel: non-finite velocity ignored'
                                       % self._names[robot])
             return
-        self._fleet.command(robot, velocity, self._seconds(self.get_clock().now().nanoseconds))
+        if (self._fleet.differential[robot] and msg.linear.y != 0.0
+                and robot not in self._sideways_logged):
+            self._sideways_logged.add(robot)
+            self.get_logger().warning('%s/cmd_vel: linear.y = %g ignored: a differential '
+                                      'robot cannot move sideways (logged once)'
+                                      % (self._names[robot], msg.linear.y))
+        self._fleet.command(robot, velocity, self._seconds(self.get_clock().now().nanoseconds),
+                            msg.angular.z)
 
     def _step(self):
         """One simulation step and its messages (the timer); a bug is logged, not fatal."""
@@ -91,9 +101,16 @@ class FleetSim(Node):
         settings = self._node_parameters.settings
         header = conversions.header(settings.frame_id, now_ns)
         states = PoseArray(header=header)
+        fleet = self._fleet
+        yaws = fleet.headings
+        orientations = np.c_[np.zeros((len(yaws), 2)), np.sin(yaws / 2), np.cos(yaws / 2)]
+        # the twist is in the body frame: a differential robot's is (forward, 0, 0), yaw rate
+        twists = np.where(fleet.differential[:, None],
+                          np.c_[fleet.forward, np.zeros((len(yaws), 2))],
+                          fleet.velocities)
         for i, name in enumerate(self._names):
-            odometry = conversions.odometry(header, name + '/base_link',
-                                            self._fleet.positions[i], self._fleet.velocities[i])
+            odometry = conversions.odometry(header, name + '/base_link', fleet.positions[i],
+                                            twists[i], orientations[i], fleet.yaw_rates[i])
             states.poses.append(odometry.pose.pose)
             if name not in settings.muted_robots:
                 self._odometry[i].publish(odometry)

@@ -247,16 +247,17 @@ def vector3(values):
     return Vector3(x=x, y=y, z=z)
 
 
-def twist(linear=(0.0, 0.0, 0.0)):
-    """Return a geometry_msgs/Twist of linear velocity (3,), no rotation: zero by default."""
-    return Twist(linear=vector3(linear))
+def twist(linear=(0.0, 0.0, 0.0), yaw_rate=0.0):
+    """Return a geometry_msgs/Twist of linear velocity (3,) and angular z: zero by default."""
+    return Twist(linear=vector3(linear), angular=Vector3(z=float(yaw_rate)))
 
 
-def odometry(stamp_header, child_frame_id, position, velocity):
-    """Return a nav_msgs/Odometry: position (3,) with the identity orientation, velocity (3,)."""
+def odometry(stamp_header, child_frame_id, position, velocity, orientation=IDENTITY,
+             yaw_rate=0.0):
+    """Return a nav_msgs/Odometry: pose position (3,), orientation; twist velocity (3,), yaw."""
     message = Odometry(header=stamp_header, child_frame_id=child_frame_id)
-    message.pose.pose = pose(position)
-    message.twist.twist = twist(velocity)
+    message.pose.pose = pose(position, orientation)
+    message.twist.twist = twist(velocity, yaw_rate)
     return message
 
 

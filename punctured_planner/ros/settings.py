@@ -24,7 +24,9 @@ from .parameters import Table
 from .parameters import within
 from ..core import VARIANTS
 from ..execution import Bodies
+from ..execution import DRIVES
 from ..execution import ExecutionSettings
+from ..execution.execution import differential_mask
 from ..sim import FleetSettings
 
 # The variant parameter's default: 'discs' with a robot radius, else 'spread'.
@@ -148,6 +150,28 @@ def _planner_robot_count(settings: PlannerSettings) -> None:
 PLANNER = Table('planner_node', PlannerSettings, checks=(_planner_robot_count,))
 
 
+def _drives(name: str, value: tuple) -> None:
+    """Refuse an empty drive list or an entry that is not a known drive."""
+    if not value:
+        raise ValueError('%s must hold one value or one per robot, got []' % name)
+    bad = [i for i, item in enumerate(value) if item not in DRIVES]
+    if bad:
+        raise ValueError('%s[%d] = %r is not one of %s'
+                         % (name, bad[0], value[bad[0]], ', '.join(DRIVES)))
+
+
+# The robots' drive, for the executor's tracking law and the simulator's kinematics alike.
+DRIVE = Spec(
+    'drive', 'string_array', ['holonomic'],
+    "How the robots move: 'holonomic' (any planar velocity) or 'differential' (forward "
+    'speed linear.x and yaw rate angular.z only: a unicycle); one value for all, or one '
+    'per robot in robot order.', check=_drives,
+    prose="'holonomic' or 'differential': one, or one per robot")
+YAW_RATE_LIMIT = Spec(
+    'yaw_rate_limit', 'double', 1.0,
+    "Differential robots' yaw-rate limit (rad/s).", low=1e-6, high=1e3)
+
+
 @dataclass(frozen=True)
 class ExecutorSettings:
     """plan_executor's parameters."""
@@ -193,6 +217,13 @@ class ExecutorSettings:
         "'on': one plan clock for all robots, slowed and held by their errors; 'off': "
         "every robot follows the plan's stamps on its own (for comparison).",
         choices=('on', 'off')).field()
+    drive: tuple = DRIVE.field()
+    yaw_rate_limit: float = YAW_RATE_LIMIT.field()
+    final_heading: str = Spec(
+        'final_heading', 'string', 'request',
+        "'request': after the plan's end every differential robot turns in place to the "
+        "orientation of its last pose (the request's; identity faces +x); 'none': it "
+        'stops facing where it arrived.', choices=('request', 'none')).field()
 
     @property
     def execution(self) -> ExecutionSettings:
@@ -201,7 +232,9 @@ class ExecutorSettings:
                                  slow_fraction=self.slow_fraction,
                                  hold_fraction=self.hold_fraction,
                                  goal_tolerance=self.goal_tolerance,
-                                 shared_clock=self.shared_clock == 'on')
+                                 shared_clock=self.shared_clock == 'on', drive=self.drive,
+                                 yaw_rate_limit=self.yaw_rate_limit,
+                                 final_heading=self.final_heading == 'request')
 
 
 def _slow_below_hold(settings: ExecutorSettings) -> None:
@@ -263,6 +296,17 @@ class FleetSimSettings:
         'Robots whose odometry is not published (a dropped link); they keep moving. '
         'Settable at run time, like the physics parameters.',
         prose='names among robot_names').field()
+    drive: tuple = DRIVE.field()
+    yaw_rate_limit: float = YAW_RATE_LIMIT.field()
+    max_acceleration: float = Spec(
+        'max_acceleration', 'double', 0.0,
+        "Differential robots' linear acceleration limit (m/s^2): the executed forward "
+        'speed moves toward the command at most this fast; 0: at once.',
+        low=0.0, high=1e3).field()
+    max_yaw_acceleration: float = Spec(
+        'max_yaw_acceleration', 'double', 0.0,
+        "Differential robots' yaw acceleration limit (rad/s^2); 0: at once.",
+        low=0.0, high=1e4).field()
 
     @property
     def initial(self) -> np.ndarray:
@@ -280,11 +324,13 @@ class FleetSimSettings:
             speed_factors=np.asarray(self.speed_factors) if self.speed_factors else None,
             latencies=np.asarray(self.latencies) if self.latencies else None,
             velocity_noise=self.velocity_noise, command_timeout=self.command_timeout,
-            seed=self.seed)
+            seed=self.seed, differential=differential_mask(self.drive, len(self.robot_names)),
+            yaw_rate_limit=self.yaw_rate_limit, max_acceleration=self.max_acceleration,
+            max_yaw_acceleration=self.max_yaw_acceleration)
 
 
 def _fleet_counts(settings: FleetSimSettings) -> None:
-    """Refuse other than 3 coordinates, one factor and latency per robot; unknown muted."""
+    """Refuse other than 3 coordinates, one factor, latency and drive per robot; unknown muted."""
     count = len(settings.robot_names)
     if len(settings.initial_positions) != 3 * count:
         raise ValueError('initial_positions has %d values for %d robot_names (3 per robot)'
@@ -293,6 +339,7 @@ def _fleet_counts(settings: FleetSimSettings) -> None:
         values = getattr(settings, name)
         if values and len(values) != count:
             raise ValueError('%s has %d values for %d robots' % (name, len(values), count))
+    differential_mask(settings.drive, count)
     unknown = [name for name in settings.muted_robots if name not in settings.robot_names]
     if unknown:
         raise ValueError('muted_robots names %s, not among robot_names' % ', '.join(unknown))

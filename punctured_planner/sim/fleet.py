@@ -1,16 +1,25 @@
 """
-Holonomic disc robots with a slow robot, command latency and velocity noise.
+Disc robots, holonomic or differential, with a slow robot, command latency and noise.
 
-The robots never turn: their body frame is the odometry frame, so a command's
-linear velocity is applied as it is (the executor rotates world velocities
-into each robot's body frame from its odometry orientation). Per robot i and
-step dt, with the latest command whose latency has passed (none, or one older
-than ``command_timeout``: 0):
+Per robot i and step dt, with the latest command whose latency has passed
+(none, or one older than ``command_timeout``: 0):
 
-    v_i = speed_factor_i * sat(command, speed_limit) * (1 + velocity_noise * xi),
+* holonomic: the robot never turns, its body frame is the odometry frame, so
+  the command's linear velocity is applied as it is (the executor rotates
+  world velocities into each robot's body frame from its odometry orientation):
 
-xi standard normal per axis; the centre moves by v_i dt on a straight line. The
-true gap (:class:`punctured_planner.execution.Bodies`) is exact over each step.
+      v_i = speed_factor_i * sat(command, speed_limit) * (1 + velocity_noise * xi),
+
+  xi standard normal per axis; the centre moves by v_i dt on a straight line;
+* differential (a unicycle): only linear.x and angular.z count (linear.y is
+  ignored, as on a real base); each is clipped to its limit, then moves toward
+  it at most by its acceleration limit times dt (0: at once), then is scaled by
+  speed_factor_i and 1 + velocity_noise * xi; the heading turns at the yaw rate
+  and the centre moves on the exact arc.
+
+The true gap (:class:`punctured_planner.execution.Bodies`) is exact over each
+holonomic step; a differential step's arc is within its sagitta,
+|v| dt |omega| dt / 8, of its chord, and that is taken off the chord's gaps.
 """
 
 from collections import deque
@@ -21,6 +30,7 @@ import numpy as np
 
 from ..execution.bodies import Bodies
 from ..execution.execution import saturate
+from ..execution.unicycle import headings
 
 
 @dataclass(frozen=True)
@@ -34,6 +44,10 @@ class FleetSettings:
     velocity_noise: float = 0.0
     command_timeout: float = 0.5
     seed: int = 0
+    differential: np.ndarray | None = None    # (k,) bool, None: all holonomic
+    yaw_rate_limit: float = 1.0               # rad/s, differential robots
+    max_acceleration: float = 0.0             # m/s^2, differential robots; 0: unlimited
+    max_yaw_acceleration: float = 0.0         # rad/s^2, differential robots; 0: unlimited
 
 
 @dataclass(frozen=True)
@@ -56,8 +70,14 @@ class Fleet:
         k = len(self.positions)
         self.configure(settings)
         self.velocities = np.zeros((k, 3))
-        self._pending: list[deque] = [deque() for _ in range(k)]  # (apply_time, velocity)
-        self._active = np.zeros((k, 3))
+        self.headings = np.zeros(k)       # yaw (rad): differential robots turn, others not
+        self.forward = np.zeros(k)        # executed forward speeds, differential robots
+        self.yaw_rates = np.zeros(k)      # executed yaw rates, differential robots
+        self._moves = np.zeros((k, 3))    # the last step's chords, differential robots
+        self._ramped = np.zeros((k, 2))   # (forward, yaw rate) after the acceleration limits
+        # (apply_time, linear velocity (3,), yaw rate)
+        self._pending: list[deque] = [deque() for _ in range(k)]
+        self._active = np.zeros((k, 4))
         self._active_since = np.full(k, -np.inf)
         self._rng = np.random.default_rng(settings.seed)
         gaps, _, _ = settings.bodies.pair_gaps(self.positions)
@@ -72,19 +92,28 @@ class Fleet:
                               else np.asarray(settings.speed_factors, dtype=float))
         self.latencies = (np.zeros(k) if settings.latencies is None
                           else np.asarray(settings.latencies, dtype=float))
+        self.differential = (np.zeros(k, dtype=bool) if settings.differential is None
+                             else np.asarray(settings.differential, dtype=bool))
 
     @property
     def robot_count(self) -> int:
         """Return k."""
         return len(self.positions)
 
-    def command(self, robot: int, velocity: np.ndarray, now: float) -> None:
-        """Queue a robot's commanded velocity (3,), received at now; it applies after latency."""
+    def command(self, robot: int, velocity: np.ndarray, now: float,
+                yaw_rate: float = 0.0) -> None:
+        """
+        Queue a robot's command, received at now; it applies after the robot's latency.
+
+        velocity (3,) is the linear velocity in the body frame, yaw_rate the
+        angular z (a holonomic robot ignores it, a differential one uses only
+        velocity[0] and it).
+        """
         self._pending[robot].append((now + self.latencies[robot],
-                                     np.asarray(velocity, dtype=float)))
+                                     np.append(np.asarray(velocity, dtype=float), yaw_rate)))
 
     def _commanded(self, now: float) -> np.ndarray:
-        """Return the (k, 3) commands in force at now (latest applied, 0 if timed out)."""
+        """Return the (k, 4) commands (linear, yaw rate) in force at now (0 if timed out)."""
         for robot, pending in enumerate(self._pending):
             while pending and pending[0][0] <= now:
                 self._active_since[robot], self._active[robot] = pending.popleft()
@@ -93,15 +122,48 @@ class Fleet:
         commanded[timed_out] = 0.0
         return commanded
 
+    def _unicycle_step(self, commanded: np.ndarray, dt: float) -> np.ndarray:
+        """Turn and drive the differential robots for dt; return their arcs' sagittas (k,)."""
+        s = self.settings
+        wanted = np.c_[np.clip(commanded[:, 0], -s.speed_limit, s.speed_limit),
+                       np.clip(commanded[:, 3], -s.yaw_rate_limit, s.yaw_rate_limit)]
+        limits = np.array([s.max_acceleration, s.max_yaw_acceleration]) * dt
+        change = wanted - self._ramped
+        self._ramped = np.where(limits > 0, self._ramped + np.clip(change, -limits, limits),
+                                wanted)
+        noise = 1.0 + s.velocity_noise * self._rng.standard_normal((len(wanted), 2))
+        executed = np.where(self.differential[:, None], self._ramped, 0.0)
+        forward, yaw_rate = (self.speed_factors[:, None] * executed * noise).T
+        turned = yaw_rate * dt
+        # the exact arc: the chord has length 2 v sin(w dt / 2) / w, along the mid heading
+        chord = forward * dt * np.sinc(turned / (2.0 * np.pi))
+        middle = self.headings + 0.5 * turned
+        self.forward, self.yaw_rates = forward, yaw_rate
+        self._moves = chord[:, None] * headings(middle)
+        self.headings = (self.headings + turned + np.pi) % (2.0 * np.pi) - np.pi
+        return np.abs(forward * dt * turned) / 8.0
+
     def step(self, now: float, dt: float) -> list:
         """Move every robot for dt seconds from time now; return the new Contacts."""
         s = self.settings
-        commanded = saturate(self._commanded(now), s.speed_limit)
-        noise = 1.0 + s.velocity_noise * self._rng.standard_normal(commanded.shape)
-        self.velocities = self.speed_factors[:, None] * commanded * noise
+        commanded = self._commanded(now)
+        linear = saturate(commanded[:, :3], s.speed_limit)
+        noise = 1.0 + s.velocity_noise * self._rng.standard_normal(linear.shape)
+        holonomic = self.speed_factors[:, None] * linear * noise
+        sagittas = np.zeros(self.robot_count)
+        if self.differential.any():
+            sagittas = np.where(self.differential, self._unicycle_step(commanded, dt), 0.0)
+            self.velocities = np.where(self.differential[:, None], self._moves / max(dt, 1e-12),
+                                       holonomic)
+        else:
+            self.velocities = holonomic
         start = self.positions
         self.positions = start + self.velocities * dt
         gaps, a, b = s.bodies.pair_gaps(start, self.positions)
+        if sagittas.any():
+            # the arcs bow out of their chords by at most their sagittas: be conservative
+            padded = np.concatenate([sagittas, np.zeros(len(s.bodies.obstacles))])
+            gaps = gaps - padded[a] - padded[b]
         if gaps.size:
             self.min_gap = min(self.min_gap, float(gaps.min()))
         touching = gaps < 0
