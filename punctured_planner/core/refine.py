@@ -144,9 +144,8 @@ class _Knots:
     points: np.ndarray
 
     @classmethod
-    def of(cls, union: _Union, segments: int) -> '_Knots':
-        """Return the KNOTS knots a segment on the union motion."""
-        knots = knot_times(segments, KNOTS)
+    def of(cls, union: _Union, knots: np.ndarray) -> '_Knots':
+        """Return the knots (N,), every one a breakpoint of the union motion, located on it."""
         interval = np.clip(np.searchsorted(knots, union.times, side='right') - 1, 0,
                            knots.size - 2)
         fraction = (union.times - knots[interval]) / (knots[interval + 1] - knots[interval])
@@ -331,8 +330,9 @@ def refine(times: np.ndarray, positions: np.ndarray, waypoint_indices: np.ndarra
     k, d = positions.shape[1:]
     configurations = positions[waypoint_indices]
     segments = len(waypoint_indices) - 1
-    union = union_motion(times, positions, waypoint_indices, knot_times(segments, KNOTS))
-    knots = _Knots.of(union, segments)
+    knot_grid = knot_times(segments, KNOTS)
+    union = union_motion(times, positions, waypoint_indices, knot_grid)
+    knots = _Knots.of(union, knot_grid)
     gap = certify(union.times, union.positions, bodies.obstacles,
                   bodies.radii if np.any(bodies.radii > 0) else None).distance
     bodies = Bodies(bodies.obstacles, bodies.radii, min(bodies.margin, gap), bodies.rounding)

@@ -136,12 +136,17 @@ class Execution:
         if not stale.any():
             self.min_gap = min(self.min_gap, self.bodies.smallest_gap(positions).value)
         differential = self.differential & ~stale
-        # the clock watches each differential robot's bound E of its centre error
-        lead_points = unicycle.lead_points(positions, self._driving(angles), self.lead)
-        watched = np.where(differential, np.linalg.norm(reference_now - lead_points, axis=1)
-                           + self.lead, errors)
         dt = min(max(dt, 0.0), MAX_STEP)
-        alpha = self._update_turns(angles, watched)
+        # An all-holonomic fleet (the default) needs none of the unicycle's work.
+        unicycles = bool(self.differential.any())
+        watched, alpha = errors, np.zeros(k)
+        if unicycles:
+            # the clock watches each differential robot's bound E of its centre error
+            lead_points = unicycle.lead_points(positions, self._driving(angles), self.lead)
+            watched = np.where(differential,
+                               np.linalg.norm(reference_now - lead_points, axis=1)
+                               + self.lead, errors)
+            alpha = self._update_turns(angles, watched)
         driving = self._driving(angles)
         if not s.shared_clock:
             rate = 1.0
@@ -155,11 +160,13 @@ class Execution:
         target = self.reference.position(self.plan_time)
         command = rate * self.reference.velocity(self.plan_time) + s.gain * (target - positions)
         velocities = saturate(command, s.speed_limit)
-        unicycle_command = self._unicycle(rate, target, positions, angles, driving, alpha)
-        forward = np.where(differential, unicycle_command.forward, 0.0)
-        yaw_rates = np.where(differential, unicycle_command.yaw_rate, 0.0)
-        velocities = np.where(differential[:, None],
-                              forward[:, None] * unicycle.headings(angles), velocities)
+        forward, yaw_rates = np.zeros(k), np.zeros(k)
+        if unicycles:
+            unicycle_command = self._unicycle(rate, target, positions, angles, driving, alpha)
+            forward = np.where(differential, unicycle_command.forward, 0.0)
+            yaw_rates = np.where(differential, unicycle_command.yaw_rate, 0.0)
+            velocities = np.where(differential[:, None],
+                                  forward[:, None] * unicycle.headings(angles), velocities)
         velocities[stale] = 0.0
         arrived = bool(self.plan_time >= duration and not stale.any() and np.all(
             np.linalg.norm(target - positions, axis=1) <= s.goal_tolerance))

@@ -31,6 +31,7 @@ import numpy as np
 from ..execution.bodies import Bodies
 from ..execution.execution import saturate
 from ..execution.unicycle import headings
+from ..execution.unicycle import wrap
 
 
 @dataclass(frozen=True)
@@ -140,7 +141,7 @@ class Fleet:
         middle = self.headings + 0.5 * turned
         self.forward, self.yaw_rates = forward, yaw_rate
         self._moves = chord[:, None] * headings(middle)
-        self.headings = (self.headings + turned + np.pi) % (2.0 * np.pi) - np.pi
+        self.headings = wrap(self.headings + turned)
         return np.abs(forward * dt * turned) / 8.0
 
     def step(self, now: float, dt: float) -> list:
