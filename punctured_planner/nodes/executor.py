@@ -167,17 +167,15 @@ class PlanExecutor(Node):
         """Accept a cancel of the active goal and stop every robot at once."""
         run = self._run
         if run is not None and run.goal is goal:
-            self._stop_robots(run.plan.names)
-            self._finish(run, Result.CANCELED, 'canceled at plan time %.3f s'
-                         % (run.execution.plan_time if run.execution else 0.0))
+            self._end(run, Result.CANCELED, 'canceled at plan time %.3f s'
+                      % (run.execution.plan_time if run.execution else 0.0))
         return CancelResponse.ACCEPT
 
     async def _execute(self, goal):
         """Run one goal to its end; return its ExecutePlan result."""
         previous = self._run
         if previous is not None:
-            self._stop_robots(previous.plan.names)
-            self._finish(previous, Result.PREEMPTED, 'preempted by a newer goal')
+            self._end(previous, Result.PREEMPTED, 'preempted by a newer goal')
         found = self._plans.lookup(goal.request.plan_id, self.resolve_topic_name('plan'))
         if found.code == Result.NO_PLAN:
             found = await self._wait_for_plan(goal.request.plan_id)
@@ -231,6 +229,11 @@ class PlanExecutor(Node):
                           % (found.plan.plan_id, ', '.join(found.plan.names), error))
         return found
 
+    def _end(self, run, code, message):
+        """Stop the run's robots, then end its goal with code and message."""
+        self._stop_robots(run.plan.names)
+        self._finish(run, code, message)
+
     def _finish(self, run, code, message):
         """End a run with a result (once); the goal's coroutine resumes with it."""
         if run.done.done():
@@ -257,9 +260,8 @@ class PlanExecutor(Node):
         try:
             self._control_run(run)
         except Exception as error:  # noqa: B902 - a bug ends the goal, not the node
-            self._stop_robots(run.plan.names)
-            self._finish(run, Result.UNKNOWN, 'internal error: %s: %s'
-                         % (type(error).__name__, error))
+            self._end(run, Result.UNKNOWN, 'internal error: %s: %s'
+                      % (type(error).__name__, error))
 
     def _control_run(self, run):
         """Start the goal's Execution once every robot reported, then step and publish it."""
@@ -353,10 +355,9 @@ class PlanExecutor(Node):
         if run is None:
             return None
         self._halted = run.plan.names
-        self._stop_robots(run.plan.names)
-        self._finish(run, Result.STOPPED, 'plan_executor stopped at plan time %.3f s; its '
-                     'robots were sent zero velocity'
-                     % (run.execution.plan_time if run.execution else 0.0))
+        self._end(run, Result.STOPPED, 'plan_executor stopped at plan time %.3f s; its '
+                  'robots were sent zero velocity'
+                  % (run.execution.plan_time if run.execution else 0.0))
         return run.ended
 
     def stop_halted_robots(self):

@@ -201,7 +201,7 @@ def plan_to_paths(samples, orientations, frame_id, start_ns, plane_z=0.0):
     quaternions = normalized_quaternions(orientations).transpose(1, 0, 2)
     stamps = stamps_ns(start_ns, samples.values)
     waypoint = samples.last_waypoint()
-    headers = [Header(frame_id=frame_id, stamp=time_from_ns(stamp)) for stamp in stamps.tolist()]
+    headers = [header(frame_id, stamp) for stamp in stamps.tolist()]
     held = [[_filled(Quaternion, x=qx, y=qy, z=qz, w=qw) for qx, qy, qz, qw in robot]
             for robot in quaternions.tolist()]
     paths = Paths()
@@ -210,17 +210,16 @@ def plan_to_paths(samples, orientations, frame_id, start_ns, plane_z=0.0):
     new = object.__new__
     for robot_xyz, robot_held in zip(xyz.tolist(), held):
         poses = []
-        for header, (x, y, z), m in zip(headers, robot_xyz, waypoint.tolist()):
+        for pose_header, (x, y, z), m in zip(headers, robot_xyz, waypoint.tolist()):
             point = new(Point)
             point._x, point._y, point._z, point._check_fields = x, y, z, False
             pose = new(Pose)
             pose._position, pose._orientation = point, robot_held[m]
             pose._check_fields = False
             stamped = new(PoseStamped)
-            stamped._header, stamped._pose, stamped._check_fields = header, pose, False
+            stamped._header, stamped._pose, stamped._check_fields = pose_header, pose, False
             poses.append(stamped)
-        paths.append(_filled(Path, header=Header(frame_id=frame_id,
-                                                 stamp=time_from_ns(start_ns)), poses=poses))
+        paths.append(_filled(Path, header=header(frame_id, start_ns), poses=poses))
     return paths
 
 
@@ -268,7 +267,7 @@ def domain_index_message(plan):
 
 def empty_path(frame_id, stamp_ns):
     """Return a nav_msgs/Path with no poses: 'no current plan' for a robot."""
-    return Path(header=Header(frame_id=frame_id, stamp=time_from_ns(stamp_ns)))
+    return Path(header=header(frame_id, stamp_ns))
 
 
 # ---------------------------------------------------------------- the response
