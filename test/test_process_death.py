@@ -145,10 +145,13 @@ def test_fleet_sim_killed(graph):
 
 
 def test_planner_node_killed(graph):
+    from punctured_planner.cli import wait_for_result
     from punctured_planner_interfaces.action import ExecutePlan
-    handle, _, _ = moving_goal(graph)
+    handle, _, watch = moving_goal(graph)
     kill(graph.processes['planner_node'])
-    result = graph.result(handle, timeout_sec=30)
+    # the feedback goes on until the result: the client's wait ends with it
+    result = wait_for_result(graph.client.executor, handle, watch, 30)
+    assert result is not None, graph.logs()
     assert result.error_code == ExecutePlan.Result.NONE, result.error_msg + graph.logs()
     assert graph.client.spin_until(lambda: graph.gap, 5)
     assert graph.gap[-1] >= 0.0
