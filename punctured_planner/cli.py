@@ -73,6 +73,46 @@ def spin_until(executor, predicate, timeout_sec):
     return True
 
 
+# Seconds without feedback after which a running goal's executor counts as gone:
+# plan_executor sends feedback every control step (20 Hz by default, msg_docs/ExecutePlan.md),
+# while DDS itself notices a killed process only when its lease ends (about 20 s).
+FEEDBACK_SILENCE_SEC = 2.0
+
+
+class GoalWatch:
+    """When an ExecutePlan goal's feedback last came: pass :meth:`heard` as its callback."""
+
+    def __init__(self) -> None:
+        """Start with no feedback heard."""
+        self.last_feedback: float | None = None  # time.monotonic()
+
+    def heard(self, feedback) -> None:
+        """Feedback callback of send_goal_async: the executor is alive now."""
+        self.last_feedback = time.monotonic()
+
+    def silent_for(self) -> float:
+        """Return the seconds since the last feedback (0 before the first)."""
+        if self.last_feedback is None:
+            return 0.0
+        return time.monotonic() - self.last_feedback
+
+
+def wait_for_result(executor, handle, watch: GoalWatch, timeout_sec: float,
+                    silence_sec: float = FEEDBACK_SILENCE_SEC):
+    """
+    Spin until the goal's result; return it, or None when the executor went away.
+
+    None once the goal's feedback, after it started, stopped for ``silence_sec``
+    (plan_executor died: no result will come) or ``timeout_sec`` passed.
+    """
+    future = handle.get_result_async()
+    gone = spin_until(executor, lambda: future.done() or watch.silent_for() > silence_sec,
+                      timeout_sec)
+    if gone and future.done():
+        return future.result().result
+    return None
+
+
 @contextlib.contextmanager
 def _ros_session():
     """Yield (node, executor) in a private rclpy Context; shut everything down after."""

@@ -28,7 +28,10 @@ import time
 import numpy as np
 import yaml
 
+from .cli import FEEDBACK_SILENCE_SEC
+from .cli import GoalWatch
 from .cli import spin_until
+from .cli import wait_for_result
 
 CONFIG = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), 'config')
 NODES = ('fleet_sim', 'planner_node', 'plan_executor')
@@ -124,11 +127,17 @@ def _run(recorder, request_path, mcap_path, gif_path):
     print('planned plan %d: %d robots, %.2f s at %.2f m/s, min gap %.3f m, tolerance %.3f m'
           % (response.plan_id, len(response.paths), planned, request.max_speed,
              2 * response.tracking_tolerance, response.tracking_tolerance))
-    goal = action.send_goal_async(ExecutePlan.Goal(plan_id=response.plan_id))
-    recorder.spin(goal.done, 10)
-    result_future = goal.result().get_result_async()
-    recorder.spin(result_future.done, 600)
-    result = result_future.result().result
+    watch = GoalWatch()
+    goal = action.send_goal_async(ExecutePlan.Goal(plan_id=response.plan_id),
+                                  feedback_callback=watch.heard)
+    if not recorder.spin(goal.done, 10):
+        print('demo: plan_executor did not answer the goal', file=sys.stderr)
+        return 1
+    result = wait_for_result(recorder.executor, goal.result(), watch, 600)
+    if result is None:
+        print('demo: no result from plan_executor: no feedback for %g s (it went away)'
+              % FEEDBACK_SILENCE_SEC, file=sys.stderr)
+        return 1
     recorder.spin(lambda: False, 0.3)
     executed = result.executed_duration.sec + result.executed_duration.nanosec * 1e-9
     gap = recorder.gap[-1] if recorder.gap else float('nan')

@@ -20,8 +20,10 @@ fresh odometry of every robot (``UNKNOWN_ROBOTS``) in the plan's frame
 (``FRAME_MISMATCH``); then it runs until every robot has arrived (``NONE``),
 a cancel (``CANCELED``: every robot is sent zero velocity from the cancel
 callback itself, without waiting for the next tick), a newer goal
-(``PREEMPTED``) or odometry in another frame (``FRAME_MISMATCH``). Stale
-odometry never ends a goal: the clock holds until the robot is back.
+(``PREEMPTED``), odometry in another frame (``FRAME_MISMATCH``) or odometry
+stale for longer than ``hold_timeout`` (``ODOMETRY_LOST``: the clock held that
+long, every robot is sent zero velocity). A stale robot gets zero velocity from
+the first control step that finds its odometry older than ``odom_timeout``.
 Everything runs on one single-threaded executor, so callbacks never overlap.
 On Ctrl-C or SIGTERM new goals are rejected, the active goal's robots are
 sent zero velocity and the goal aborts with ``STOPPED`` (the runtime's
@@ -83,6 +85,7 @@ class Run:
     started_ns: int = 0
     last_ns: int = 0
     stale: tuple = ()
+    stale_since: int | None = None  # ns: the first control step of the current hold
     ended: Future = field(default_factory=Future)  # done once the goal's result is out
 
 
@@ -274,6 +277,8 @@ class PlanExecutor(Node):
             return
         if run.execution is None and not self._start(run, state, now):
             return
+        if self._hold_expired(run, state, now):
+            return
         step = run.execution.step((now - run.last_ns) * 1e-9, state.positions,
                                   state.stale_mask, state.orientations)
         run.last_ns = now
@@ -302,6 +307,25 @@ class PlanExecutor(Node):
         run.started_ns = run.last_ns = now
         self.get_logger().info('executing plan %d: %d robots, %.3f s'
                                % (plan.plan_id, len(plan.names), plan.reference.duration))
+        return True
+
+    def _hold_expired(self, run: Run, state: FleetState, now: int) -> bool:
+        """End the goal ODOMETRY_LOST once the clock held hold_timeout for stale odometry."""
+        if not state.stale:
+            run.stale_since = None
+            return False
+        if run.stale_since is None:
+            run.stale_since = now
+        held = (now - run.stale_since) * 1e-9
+        timeout = self._settings.hold_timeout
+        if held < timeout:
+            return False
+        self._end(run, Result.ODOMETRY_LOST, 'odometry of %s stale (older than %g s; topics '
+                  '%s): the plan clock held %.3f s at plan time %.3f s, hold_timeout %g s; '
+                  'every robot was sent zero velocity'
+                  % (', '.join(state.stale), self._settings.odom_timeout,
+                     ', '.join(self.resolve_topic_name(n + '/odom') for n in state.stale),
+                     held, run.execution.plan_time, timeout))
         return True
 
     def _log_stale(self, run: Run, state: FleetState, plan_time: float) -> None:

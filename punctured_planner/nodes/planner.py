@@ -24,8 +24,8 @@ the subscriptions. Not rclpy's MultiThreadedExecutor: in rclpy 7.1 it busy-
 loops on subscription traffic (ros2/rclpy#1223, #1452), and measured here, with
 obstacles and robot states at 50 Hz, service round trips went from 4 ms to 80
 ms median with stalls of 2-6 s (two single-threaded executors: 3.4 ms, worst 6
-ms). A plan is answered first; then it is published, complete, in the order
-msg_docs/topics.md gives. Start and stop (Ctrl-C and
+ms). A plan is answered first; then the request's outcome is logged and the
+plan published, complete, in the order msg_docs/topics.md gives. Start and stop (Ctrl-C and
 SIGTERM alike, threads joined before anything is destroyed):
 :func:`punctured_planner.ros.runtime.run_nodes`.
 """
@@ -73,7 +73,7 @@ SEND_ATTEMPTS = 10
 
 @dataclass(frozen=True)
 class AfterReply:
-    """A certified plan to publish once its reply is sent: request number, outcome, settings."""
+    """A request's outcome to log (and publish, if planned) once its reply is sent."""
 
     number: int
     outcome: Outcome
@@ -215,8 +215,17 @@ class PlannerNode(Node):
         if outcome.ok:
             self._plan_count += 1
             outcome.plan_id = response.plan_id = self._plan_count
-            # Published by _send_response once the reply is out (answer first).
-            self._after_reply = AfterReply(number, outcome, snapshot.settings)
+        # Logged, and published if planned, by _send_response once the reply is out
+        # (answer first): each rclpy log line looks up its caller's source file
+        # through inspect, a cost the reply need not wait for.
+        self._after_reply = AfterReply(number, outcome, snapshot.settings)
+        return response
+
+    def _log_outcome(self, after: AfterReply) -> None:
+        """Log how a request ended: planned, refused, or an internal error with its traceback."""
+        number, outcome, response = after.number, after.outcome, after.outcome.response
+        logger = self.get_logger()
+        if outcome.ok:
             p = outcome.plan
             logger.info('plan_sequence #%d: planned k=%d n=%d, domain %d of %d, clearance '
                         '%.6g, %.3f ms' % (number, p.positions.shape[1],
@@ -230,7 +239,6 @@ class PlannerNode(Node):
         else:
             logger.warning('plan_sequence #%d: error %d: %s'
                            % (number, response.error_code, response.error_msg))
-        return response
 
     def _send_response(self, response, header):
         """
@@ -247,7 +255,9 @@ class PlannerNode(Node):
         finally:
             after, self._after_reply = self._after_reply, None
             if after is not None:
-                self._publish_after_reply(after)
+                self._log_outcome(after)
+                if after.outcome.ok:
+                    self._publish_after_reply(after)
 
     def _send_attempts(self, response, header, number, sequence):
         """Send one reply, up to SEND_ATTEMPTS times while rmw reports the timeout."""

@@ -224,8 +224,13 @@ def plan_to_paths(samples, orientations, frame_id, start_ns, plane_z=0.0):
 
 
 def header(frame_id, stamp_ns):
-    """Return a std_msgs/Header in frame_id at integer nanoseconds."""
-    return Header(frame_id=frame_id, stamp=time_from_ns(stamp_ns))
+    """
+    Return a std_msgs/Header in frame_id (a str) at integer nanoseconds.
+
+    Filled in place (:func:`_filled`): Header's constructor would first build a
+    default Time only to replace it, for every stamp of every path.
+    """
+    return _filled(Header, frame_id=frame_id, stamp=time_from_ns(stamp_ns))
 
 
 def pose(position, orientation=IDENTITY):
@@ -272,8 +277,8 @@ def empty_path(frame_id, stamp_ns):
 
 # ---------------------------------------------------------------- the response
 
-def fill_response(response, plan, paths, planning_time, max_speed, waypoints, dropped=()):
-    """Fill every field of a PlanSequence response from a successful plan."""
+def fill_response(response, plan, paths, planning_time, duration, waypoints, dropped=()):
+    """Fill every field of a PlanSequence response from a successful plan lasting duration s."""
     response.error_code = 0
     response.error_msg = ''
     response.domain_index = int(plan.domain_index)
@@ -284,7 +289,7 @@ def fill_response(response, plan, paths, planning_time, max_speed, waypoints, dr
     response.min_clearance = float(plan.min_clearance)
     response.min_gap = float(plan.min_gap)
     response.planning_time = duration_from_seconds(planning_time)
-    response.duration = duration_from_seconds(plan.duration(max_speed))
+    response.duration = duration_from_seconds(duration)
     response.paths = paths
     response.waypoint_indices = [int(i) for i in np.asarray(waypoints).tolist()]
     response.dropped_configurations = [int(m) for m in dropped]

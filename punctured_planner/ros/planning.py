@@ -140,7 +140,7 @@ class PlanSequenceHandler:
         samples = the_plan.sample(gathered.samples_per_leg, max_speed)
         paths = conversions.plan_to_paths(samples, checked.orientations, settings.frame_id,
                                           start_ns, settings.plane_z)
-        conversions.fill_response(response, the_plan, paths, planning_time, max_speed,
+        conversions.fill_response(response, the_plan, paths, planning_time, duration,
                                   samples.waypoints, checked.dropped)
         return Outcome(response=response, plan=the_plan, paths=paths,
                        names=conversions.robot_names(settings.robot_names, gathered.counts[0]),

@@ -246,6 +246,11 @@ class ExecutorSettings:
         'discovery_timeout', 'double', 5.0,
         'How long a new goal waits for odometry from every robot of the plan before it '
         'is refused with UNKNOWN_ROBOTS (s).', low=0.0, high=1e3).field()
+    hold_timeout: float = Spec(
+        'hold_timeout', 'double', 5.0,
+        'How long the plan clock may hold for stale odometry during a goal (s): then '
+        'every robot gets zero velocity and the goal aborts with ODOMETRY_LOST.',
+        low=0.0, high=1e3).field()
     shared_clock: str = Spec(
         'shared_clock', 'string', 'on',
         "'on': one plan clock for all robots, slowed and held by their errors; 'off': "
