@@ -76,7 +76,7 @@ def spin_until(executor, predicate, timeout_sec):
 # Seconds without feedback after which a running goal's executor counts as gone:
 # plan_executor sends feedback every control step (20 Hz by default, msg_docs/ExecutePlan.md),
 # while DDS itself notices a killed process only when its lease ends (about 20 s).
-FEEDBACK_SILENCE_SEC = 2.0
+FEEDBACK_SILENCE_SEC = 5.0
 
 
 class GoalWatch:

@@ -70,7 +70,7 @@ from ..ros.snapshot import RobotOdometry
 
 Result = ExecutePlan.Result
 # Seconds a goal waits for a plan it names that was not heard yet (msg_docs/topics.md).
-PLAN_WAIT_SEC = 2.0
+PLAN_WAIT_SEC = 5.0
 
 
 @dataclass
