@@ -15,6 +15,8 @@ from core_strategies import lattice_requests, requests
 from hypothesis import assume, given, HealthCheck, settings, strategies as st
 import numpy as np
 from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
+from punctured_planner.core.refine import (_Caps, _knot_caps, _Knots, Bodies, knot_times, KNOTS,
+                                           union_motion)
 import pytest
 
 PROPERTY = settings(max_examples=80, deadline=None,
@@ -131,3 +133,64 @@ def test_required_clearance_is_judged_on_the_refined_plan():
     met = Workspace(pillars, variant='discs', robot_radius=0.2, obstacle_radius=0.1,
                     required_clearance=0.3)
     assert plan(met, request).min_gap >= 0.3
+
+
+def dense_caps(motion, knots, bodies, step):
+    """Return (pair, pillar) interval caps (N - 1, k) with every pair evaluated on every leg."""
+    k = motion.shape[1]
+    floor = bodies.margin + bodies.rounding
+    legs = np.arange(motion.shape[0] - 1)
+    pair = np.full((knots.points.size - 1, k), step)
+    pillar = np.full((knots.points.size - 1, k), 2 * step)
+    interval = np.searchsorted(knots.points, legs, side='right') - 1
+    others = [(b, True) for b in range(k)] + [(j, False) for j in range(len(bodies.obstacles))]
+    for a in range(k):
+        for b, robot in others:
+            if robot and b == a:
+                continue
+            other = motion[:, b] if robot else bodies.obstacles[b][None]
+            relative = motion[:, a] - other
+            start, velocity = relative[:-1], relative[1:] - relative[:-1]
+            t = np.clip(-np.sum(start * velocity, axis=1)
+                        / np.maximum(np.sum(velocity * velocity, axis=1), 1e-300), 0.0, 1.0)
+            distance = np.linalg.norm(start + t[:, None] * velocity, axis=1)
+            if robot:
+                slack = distance - 2 * bodies.radii[0] - floor
+                np.minimum.at(pair[:, a], interval, np.minimum(step, 0.25 * np.maximum(
+                    slack, 0.0)))
+            else:
+                slack = distance - bodies.radii[a] - bodies.radii[k + b] - floor
+                np.minimum.at(pillar[:, a], interval, np.minimum(2 * step, 0.5 * np.maximum(
+                    slack, 0.0)))
+    return pair, pillar
+
+
+@PROPERTY
+@given(st.integers(1, 7), st.integers(0, 3), st.integers(1, 3), st.sampled_from([2, 3]),
+       st.integers(0, 2 ** 31), st.sampled_from([0.01, 0.1, 1.0]),
+       st.sampled_from(['random', 'coincident', 'grid']))
+def test_pruned_caps_are_those_of_every_pair(k, r, segments, d, seed, step, mode):
+    """Caps from the pairs the boxes keep equal caps from every pair on every leg."""
+    rng = np.random.default_rng(seed)
+    breakpoints = segments * 5 + 1
+    times = np.concatenate([[0.0], np.sort(rng.uniform(0, 1, breakpoints - 2)), [1.0]])
+    waypoints = np.searchsorted(times, np.arange(segments + 1) / segments)
+    times[waypoints] = np.arange(segments + 1) / segments
+    times = np.unique(times)
+    positions = rng.uniform(-1.0, 1.0, (times.size, k, d))
+    if mode == 'coincident':  # robots on top of each other and still for a while
+        positions[:, k // 2:] = positions[:, :1]
+        positions[times.size // 2:] = positions[times.size // 2]
+    elif mode == 'grid':  # shared coordinates: ties in the sweep
+        positions = np.round(positions * 2) / 2
+    waypoints = np.searchsorted(times, np.arange(segments + 1) / segments)
+    grid = knot_times(segments, KNOTS)
+    union = union_motion(times, positions, waypoints, grid)
+    knots = _Knots.of(union, grid)
+    obstacles = rng.uniform(-1.0, 1.0, (r, d))
+    radii = np.concatenate([np.full(k, 0.1), np.full(r, 0.05)])
+    bodies = Bodies(obstacles, radii, 0.01, 1e-12)
+    caps = _Caps(union.positions, knots, bodies, step)
+    pair, pillar = dense_caps(union.positions, knots, bodies, step)
+    assert np.allclose(caps.pair, _knot_caps(pair), rtol=0.0, atol=1e-12)
+    assert np.allclose(caps.pillar, _knot_caps(pillar), rtol=0.0, atol=1e-12)
