@@ -2,7 +2,8 @@
 Planning errors: a machine-readable code plus the culprits as data, Nav2 style.
 
 A :class:`PlanningError` carries its culprits (configuration, robots,
-obstacle, coordinate) as numbers and its message as a template in which the
+obstacle, coordinate, and for OUTSIDE_WORKSPACE the wall, the distance and the
+leg) as numbers and its message as a template in which the
 configuration and obstacles are slots: ``{configuration}``, ``{obstacle}``,
 ``{obstacles}``, ``{waypoint}`` and ``{next_waypoint}`` (C_{m+1} and C_{m+2}
 of ``configuration`` m). :meth:`PlanningError.describe` fills the slots with
@@ -14,7 +15,10 @@ into a template goes through :func:`literal`.
 
 from collections.abc import Iterable
 import enum
-from typing import Any
+from typing import Any, TYPE_CHECKING
+
+if TYPE_CHECKING:  # walls imports this module
+    from .walls import Wall
 
 
 class ErrorCode(enum.IntEnum):
@@ -22,7 +26,12 @@ class ErrorCode(enum.IntEnum):
     Why a request cannot be planned; names and values match PlanSequence.srv.
 
     The order of the values is the priority order of the checks: a request with
-    several faults reports the one with the smallest value.
+    several faults reports the one with the smallest value. OUTSIDE_WORKSPACE
+    came last and is the one exception: it ranks with the input checks beside
+    ROBOT_ON_OBSTACLE (a pillar outside the bounds with the obstacles' own
+    check, right after OBSTACLES_DEGENERATE; a robot outside right after
+    ROBOT_ON_OBSTACLE), before any plan exists to fall below the required
+    clearance; a plan that leaves the bounds right after CLEARANCE_BELOW_REQUIRED.
     """
 
     NONE = 0
@@ -38,6 +47,7 @@ class ErrorCode(enum.IntEnum):
     ROBOTS_COINCIDE = 10
     ROBOT_ON_OBSTACLE = 11
     CLEARANCE_BELOW_REQUIRED = 12
+    OUTSIDE_WORKSPACE = 13
     UNKNOWN = 99
 
 
@@ -97,14 +107,20 @@ class PlanningError(ValueError):
     robot indices involved, ``obstacle`` the obstacle index (or None) and
     ``obstacles`` every obstacle involved, ``coordinate`` the axis (0 for x) of
     a faulty coordinate; ``point`` is the obstacle's position as the core
-    words it. ``message`` is the template (module docstring); ``args[0]`` and
-    ``str()`` are worded with the core's :class:`Names`.
+    words it. For OUTSIDE_WORKSPACE ``wall`` is the wall crossed (axis and
+    side), ``distance`` how far the body reaches beyond it (> 0) and ``leg``
+    the plan's leg (None for an input outside the bounds); for a plan that
+    leaves the bounds ``configuration`` is that leg's segment. ``message`` is
+    the template (module docstring); ``args[0]`` and ``str()`` are worded with
+    the core's :class:`Names`.
     """
 
     def __init__(self, code: int, message: str, configuration: int | None = None,
                  robots: Iterable[int] = (), obstacle: int | None = None,
                  obstacles: Iterable[int] = (), coordinate: int | None = None,
-                 point: Any = None, clearance: Any = None, gap: Any = None) -> None:
+                 point: Any = None, clearance: Any = None, gap: Any = None,
+                 wall: 'Wall | None' = None, distance: float | None = None,
+                 leg: int | None = None) -> None:
         """Store the code and the culprits; message is the reason's template."""
         self.code = ErrorCode(code)
         self.template = message
@@ -119,6 +135,9 @@ class PlanningError(ValueError):
         # (CLEARANCE_BELOW_REQUIRED only; gap None where rounding left it untrusted).
         self.clearance = clearance
         self.gap = gap
+        self.wall = wall
+        self.distance = distance
+        self.leg = leg
         super().__init__(self.describe(Names()))
 
     def describe(self, names: Names) -> str:

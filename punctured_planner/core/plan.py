@@ -27,6 +27,7 @@ from .space import Workspace
 from .strata import epsilon, projection_count, projection_gaps
 from .timing import breakpoint_stamps, length_times, resample
 from .validation import validate_configurations
+from .walls import check_plan_inside
 
 
 @dataclass(frozen=True, eq=False)
@@ -265,10 +266,13 @@ def plan(workspace: Workspace, configurations: npt.ArrayLike, certify: bool = Tr
     shorter, with a gap never below the construction's own exact min_gap, in
     the same domain. With certify (the default) the exact certificate is
     computed at once and a plan below workspace.required_clearance is refused
-    (its gap when robots or obstacles have a radius).
+    (its gap when robots or obstacles have a radius). Whatever certify, a plan
+    that leaves workspace.bounds is refused (OUTSIDE_WORKSPACE, core.walls:
+    exact and linear in the breakpoints), never returned.
     """
     configurations = validate_configurations(configurations, workspace.obstacles,
-                                             workspace.robot_radius, workspace.obstacle_radii)
+                                             workspace.robot_radius, workspace.obstacle_radii,
+                                             workspace.bounds)
     projections = workspace.frame.project(configurations)
     gaps = projection_gaps(projections, workspace.obstacle_projections)
     counts = projection_count(gaps)
@@ -281,6 +285,7 @@ def plan(workspace: Workspace, configurations: npt.ArrayLike, certify: bool = Tr
         result = _refined(result)
     if certify:
         _check_required_clearance(result)
+    check_plan_inside(result)
     return result
 
 

@@ -14,6 +14,7 @@ from .errors import ErrorCode, literal, PlanningError
 from .frame import checked_frame, choose_frame, Frame
 from .sections import VARIANTS
 from .validation import first_out_of_range, MAX_COORDINATE
+from .walls import checked_bounds, first_outside
 
 
 def _coincident_pair(values):
@@ -41,13 +42,18 @@ class Workspace:
     (Plan.min_gap) as soon as a radius is set.
     ``frame`` is the core's own Frame or (origin, e1, e2); by default the
     frame is chosen from the obstacles (choose_frame).
+    ``bounds`` (d, 2), [low, high] per axis in the configurations' own
+    coordinates (core.walls), are the walls of the room: every robot and
+    pillar must stay inside, a disc keeping its radius from every wall
+    (OUTSIDE_WORKSPACE); None for no walls.
     """
 
     def __init__(self, obstacles: npt.ArrayLike, dimension: int | None = None,
                  frame: Frame | tuple | None = None, lane_spacing: float = 1.0,
                  variant: str = 'paper', min_spacing: float = 0.5,
                  required_clearance: float = 0.0, robot_radius: float = 0.0,
-                 obstacle_radius: npt.ArrayLike = 0.0) -> None:
+                 obstacle_radius: npt.ArrayLike = 0.0,
+                 bounds: npt.ArrayLike | None = None) -> None:
         """Validate the obstacles and options and fix the frame."""
         obstacles = np.asarray(obstacles, dtype=float)
         if obstacles.size == 0:
@@ -75,6 +81,7 @@ class Workspace:
                                 f'{{obstacle}} is beyond the supported range '
                                 f'+-{MAX_COORDINATE:.0e}', obstacle=far[0], coordinate=far[1])
         self._check_options(variant, lane_spacing, min_spacing, required_clearance)
+        self.bounds = checked_bounds(bounds, self.dimension)
         self.obstacles = obstacles
         self.variant = variant
         self.lane_spacing = float(lane_spacing)
@@ -92,6 +99,7 @@ class Workspace:
                                 '{obstacles} share one projection on '
                                 'the frame axis e1; choose a frame that separates them',
                                 obstacle=same[0], obstacles=same)
+        self._reject_obstacles_outside()
         self.sorted_obstacle_projections = np.sort(self.obstacle_projections)
         # Lanes must clear every obstacle: start above the highest e2 offset.
         self.lane_base = max(0.0, float(self.frame.offset(obstacles).max(initial=0.0)))
@@ -108,6 +116,20 @@ class Workspace:
             raise PlanningError(ErrorCode.OBSTACLES_DEGENERATE,
                                 '{obstacles} are at the same point', obstacle=a,
                                 obstacles=(a, b))
+
+    def _reject_obstacles_outside(self):
+        """Raise OUTSIDE_WORKSPACE for a pillar whose centre is closer than rho to a wall."""
+        if self.bounds is None:
+            return
+        outside = first_outside(self.obstacles[None], self.bounds, self.obstacle_radii)
+        if outside is not None:
+            j = outside.body
+            raise PlanningError(ErrorCode.OUTSIDE_WORKSPACE,
+                                '{obstacle} is ' + outside.words(
+                                    self.bounds, self.obstacles[j, outside.wall.axis],
+                                    self.obstacle_radii[j], 'its obstacle_radius'),
+                                obstacle=j, point=self.obstacles[j].tolist(),
+                                wall=outside.wall, distance=outside.beyond)
 
     @staticmethod
     def _check_options(variant, lane_spacing, min_spacing, required_clearance):

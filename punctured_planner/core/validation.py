@@ -2,7 +2,9 @@
 Input checks: a request must be a sequence of points of F(R^d - Q_r, k).
 
 Checks run in the priority order of ErrorCode: shape and counts first, then
-non-finite values, then coincident robots, then robots on obstacles. Every
+non-finite values, then coincident robots, then robots on obstacles, then
+robots outside the workspace bounds (OUTSIDE_WORKSPACE, whose value comes
+after CLEARANCE_BELOW_REQUIRED's but which ranks here, core.errors). Every
 message names the configuration (0-based m for C_{m+1}), the robots and the
 obstacle at fault.
 """
@@ -13,6 +15,7 @@ from scipy.spatial import cKDTree
 
 from .errors import ErrorCode, literal, PlanningError
 from .pairs import pair_difference_matrix, point_pairs, with_obstacles
+from .walls import first_outside
 
 # Coordinates beyond this magnitude are refused: squared distances must not
 # overflow, and the certificate's resolution (1e-12 of the scale) stays useful.
@@ -196,12 +199,15 @@ def _first_overlap(configurations, obstacles, robot_radius, obstacle_radii):
 
 def validate_configurations(configurations: npt.ArrayLike, obstacles: np.ndarray,
                             robot_radius: float = 0.0,
-                            obstacle_radii: np.ndarray | None = None) -> np.ndarray:
+                            obstacle_radii: np.ndarray | None = None,
+                            bounds: np.ndarray | None = None) -> np.ndarray:
     """
     Return the request as a float (n, k, d) array after every check, or raise PlanningError.
 
     With radii, robot discs that overlap (ROBOTS_COINCIDE) and a robot disc that
-    overlaps an obstacle's (ROBOT_ON_OBSTACLE) are refused too.
+    overlaps an obstacle's (ROBOT_ON_OBSTACLE) are refused too. With bounds
+    (checked, core.walls), a robot whose centre is closer than robot_radius to
+    a wall, or beyond it, is refused (OUTSIDE_WORKSPACE).
     """
     checked, all_finite = _as_array(configurations, obstacles.shape[1])
     if not all_finite:
@@ -241,4 +247,20 @@ def validate_configurations(configurations: npt.ArrayLike, obstacles: np.ndarray
                             f'{robot_radius + obstacle_radii[obstacle]:.6g}',
                             configuration=m, robots=[robot], obstacle=obstacle,
                             point=obstacles[obstacle].tolist())
+    if bounds is not None:
+        _reject_outside(checked, bounds, robot_radius)
     return checked
+
+
+def _reject_outside(configurations, bounds, robot_radius):
+    """Raise OUTSIDE_WORKSPACE for the worst robot of the first C_m with one outside."""
+    outside = first_outside(configurations, bounds, robot_radius)
+    if outside is None:
+        return
+    m, robot, axis = outside.index, outside.body, outside.wall.axis
+    raise PlanningError(ErrorCode.OUTSIDE_WORKSPACE,
+                        f'{{configuration}}: robot {robot} is '
+                        + outside.words(bounds, configurations[m, robot, axis], robot_radius,
+                                        'robot_radius'),
+                        configuration=m, robots=[robot], wall=outside.wall,
+                        distance=outside.beyond)

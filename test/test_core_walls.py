@@ -1,0 +1,265 @@
+"""
+Workspace bounds (core.walls): the wall slack, the input checks and the exact plan check.
+
+Random and degenerate inputs: bodies exactly their radius from a wall (inside),
+one ulp beyond it (refused, naming the body, the wall and the distance), in
+2-D, 3-D and 4-D; motions whose slack is checked against dense samples; and
+the priority of OUTSIDE_WORKSPACE among the other codes.
+"""
+
+from fractions import Fraction
+
+from core_strategies import requests
+from hypothesis import given, HealthCheck, settings, strategies as st
+import numpy as np
+from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
+from punctured_planner.core.validation import validate_configurations
+from punctured_planner.core.walls import (checked_bounds, first_outside, smallest_leg_slack,
+                                          Wall, wall_slack)
+import pytest
+
+PROPERTY = settings(max_examples=150, deadline=None,
+                    suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+# Dyadic values: a centre placed exactly R from a wall is exactly R from it in floats too.
+DYADIC = st.integers(-64, 64).map(lambda v: v / 8)
+RADIUS = st.sampled_from([0.0, 0.125, 0.25, 0.5])
+
+
+def box(draw, d):
+    """Return (d, 2) dyadic bounds at least 4 wide on every axis."""
+    lows = [draw(DYADIC) for _ in range(d)]
+    widths = [draw(st.integers(32, 128)) / 8 for _ in range(d)]
+    return np.array([[low, low + width] for low, width in zip(lows, widths)])
+
+
+def slack_by_loops(positions, bounds, radii):
+    """Return the exact slack (N, k, d, 2) one body and wall at a time, in rationals."""
+    n, k, d = positions.shape
+    result = np.empty((n, k, d, 2), dtype=object)
+    for m in range(n):
+        for i in range(k):
+            for a in range(d):
+                centre, radius = Fraction(positions[m, i, a]), Fraction(radii[i])
+                result[m, i, a, 0] = centre - Fraction(bounds[a, 0]) - radius
+                result[m, i, a, 1] = Fraction(bounds[a, 1]) - centre - radius
+    return result
+
+
+def matches_exactly(slack, exact):
+    """Return whether every slack has the exact sign and is the exact value within 1 ulp."""
+    signs = np.vectorize(lambda v: (v > 0) - (v < 0))(exact)
+    close = np.vectorize(lambda v, e: abs(Fraction(v) - e) <= Fraction(abs(np.spacing(v))))
+    return np.array_equal(np.sign(slack), signs) and close(slack, exact).all()
+
+
+@PROPERTY
+@given(st.data())
+def test_wall_slack_is_each_centre_distance_to_each_wall_minus_its_radius(data):
+    """Vectorised slack == the exact definition (its sign exactly), one radius or one each."""
+    d = data.draw(st.integers(2, 4))
+    bounds = box(data.draw, d)
+    n, k = data.draw(st.integers(1, 4)), data.draw(st.integers(1, 6))
+    positions = np.array(data.draw(st.lists(
+        st.one_of(st.floats(-20, 20), st.sampled_from(bounds.ravel().tolist())),
+        min_size=n * k * d, max_size=n * k * d))).reshape(n, k, d)
+    radius = data.draw(st.one_of(RADIUS, st.floats(0, 3)))
+    radii = np.array(data.draw(st.lists(RADIUS, min_size=k, max_size=k)))
+    assert matches_exactly(wall_slack(positions, bounds, radius),
+                           slack_by_loops(positions, bounds, np.full(k, radius)))
+    exact = slack_by_loops(positions, bounds, radii)
+    assert matches_exactly(wall_slack(positions, bounds, radii), exact)
+    worst = first_outside(positions, bounds, radii)
+    outside = [m for m in range(n) if (exact[m] < 0).any()]
+    if not outside:
+        assert worst is None
+    else:
+        assert worst.index == outside[0] and worst.slack < 0
+        named = exact[worst.index, worst.body, worst.wall.axis, int(worst.wall.high)]
+        # the worst to within the one rounding of the slacks
+        assert named - exact[outside[0]].min() <= Fraction(abs(np.spacing(worst.slack)))
+
+
+@st.composite
+def touching(draw):
+    """Return (bounds, configurations, m, robot, wall, R): robot exactly R from the wall."""
+    d = draw(st.integers(2, 4))
+    radius = draw(RADIUS)
+    n, k = draw(st.integers(2, 3)), draw(st.integers(1, 5))
+    # robots on distinct cells of a lattice of pitch 3, walls 2 to 4 beyond it: the
+    # robot moved to a wall stays more than 2R from every other robot
+    origin = np.array([draw(DYADIC) for _ in range(d)])
+    cells = draw(st.lists(st.tuples(*[st.integers(0, 3)] * d), min_size=n * k,
+                          max_size=n * k, unique=True))
+    configurations = (origin + 3.0 * np.array(cells, dtype=float)).reshape(n, k, d)
+    margins = np.array([[draw(st.integers(16, 32)) / 8 for _ in range(2)] for _ in range(d)])
+    bounds = np.stack([origin - margins[:, 0], origin + 9 + margins[:, 1]], axis=1)
+    m, robot = draw(st.integers(0, n - 1)), draw(st.integers(0, k - 1))
+    wall = Wall(draw(st.integers(0, d - 1)), draw(st.booleans()))
+    side = bounds[wall.axis, int(wall.high)]
+    configurations[m, robot, wall.axis] = side - radius if wall.high else side + radius
+    return bounds, configurations, m, robot, wall, radius
+
+
+def nudged_out(configurations, m, robot, wall):
+    """Return configurations with the robot one ulp further toward the wall."""
+    result = configurations.copy()
+    value = result[m, robot, wall.axis]
+    result[m, robot, wall.axis] = np.nextafter(value, np.inf if wall.high else -np.inf)
+    return result
+
+
+@PROPERTY
+@given(touching())
+def test_a_robot_exactly_its_radius_from_a_wall_is_inside_one_ulp_beyond_is_refused(case):
+    """Degenerate: slack exactly 0 passes; the next float out is named with its wall."""
+    bounds, configurations, m, robot, wall, radius = case
+    obstacles = np.zeros((0, bounds.shape[0]))
+    checked = validate_configurations(configurations, obstacles, radius, None, bounds)
+    assert np.array_equal(checked, configurations)
+    with pytest.raises(PlanningError) as error:
+        validate_configurations(nudged_out(configurations, m, robot, wall), obstacles, radius,
+                                None, bounds)
+    error = error.value
+    assert error.code == ErrorCode.OUTSIDE_WORKSPACE
+    assert (error.configuration, error.robots, error.wall) == (m, (robot,), wall)
+    assert 0 < error.distance < 1e-12
+    assert error.leg is None
+    assert f'configuration {m}: robot {robot} is ' in str(error)
+    assert f'the wall {wall.name} = ' in str(error)
+
+
+@PROPERTY
+@given(touching())
+def test_a_pillar_exactly_its_radius_from_a_wall_is_inside_one_ulp_beyond_is_refused(case):
+    """The same rule for pillars, checked with the workspace (their rho from every wall)."""
+    bounds, configurations, m, robot, wall, radius = case
+    pillars = configurations[m]
+    radii = np.full(len(pillars), radius)
+    workspace = Workspace(pillars, obstacle_radius=radii, bounds=bounds)
+    assert np.array_equal(workspace.bounds, bounds)
+    with pytest.raises(PlanningError) as error:
+        Workspace(nudged_out(configurations, m, robot, wall)[m], obstacle_radius=radii,
+                  bounds=bounds)
+    error = error.value
+    assert error.code == ErrorCode.OUTSIDE_WORKSPACE
+    assert (error.obstacle, error.wall) == (robot, wall) and 0 < error.distance < 1e-12
+    assert f'obstacle {robot} at ' in str(error) and wall.name in str(error)
+
+
+@PROPERTY
+@given(st.data())
+def test_the_smallest_leg_slack_is_the_exact_minimum_over_the_motion(data):
+    """Linear along legs: no sample of any leg is below it, and a breakpoint attains it."""
+    d = data.draw(st.integers(2, 3))
+    bounds = box(data.draw, d)
+    vertices, k = data.draw(st.integers(2, 6)), data.draw(st.integers(1, 4))
+    values = data.draw(st.lists(st.floats(-30, 30), min_size=vertices * k * d,
+                                max_size=vertices * k * d))
+    positions = np.array(values).reshape(vertices, k, d)
+    radius = data.draw(RADIUS)
+    worst = smallest_leg_slack(positions, bounds, radius)
+    fractions = np.linspace(0, 1, 101)[:, None, None, None]
+    legs = (1 - fractions) * positions[None, :-1] + fractions * positions[None, 1:]
+    sampled = wall_slack(legs, bounds, radius)  # (101, legs, k, d, 2)
+    rounding = 1e-13 * max(np.abs(positions).max(), np.abs(bounds).max())  # of the samples
+    assert sampled.min() >= worst.slack - rounding
+    assert worst.slack == wall_slack(positions, bounds, radius).min()
+    leg_minima = sampled.min(axis=(0, 2, 3, 4))
+    assert leg_minima[worst.index] <= worst.slack + rounding
+    vertex_minima = wall_slack(positions, bounds, radius).min(axis=(1, 2, 3))
+    legs_before = np.minimum(vertex_minima[:-1], vertex_minima[1:])[:worst.index]
+    assert (legs_before > worst.slack).all()
+
+
+@settings(max_examples=60, deadline=None,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+@given(requests(max_robots=5, max_obstacles=3, max_configurations=3),
+       st.floats(0.05, 3.0), st.sampled_from(['paper', 'spread']))
+def test_a_plan_is_inside_its_bounds_or_refused_naming_where_it_leaves(
+        request_, margin, variant):
+    """Never a plan outside; a refusal names a robot, leg and distance that are true."""
+    obstacles, configurations, _ = request_
+    points = np.concatenate([configurations.reshape(-1, configurations.shape[2]), obstacles])
+    bounds = np.stack([points.min(axis=0) - margin, points.max(axis=0) + margin], axis=1)
+    workspace = Workspace(obstacles, dimension=configurations.shape[2], variant=variant,
+                          bounds=bounds)
+    try:
+        result = plan(workspace, configurations)
+    except PlanningError as error:
+        assert error.code == ErrorCode.OUTSIDE_WORKSPACE, str(error)
+        robot, axis, leg = error.robots[0], error.wall.axis, error.leg
+        ends = plan(Workspace(obstacles, dimension=configurations.shape[2], variant=variant),
+                    configurations).positions[leg:leg + 2, robot, axis]
+        high, low = ends.max() - bounds[axis, 1], bounds[axis, 0] - ends.min()
+        beyond = high if error.wall.high else low
+        assert beyond == pytest.approx(error.distance, rel=1e-12) and beyond > 0
+        assert f'robot {robot} ' in str(error) and f'on leg {leg} (' in str(error)
+        return
+    assert (result.positions >= bounds[:, 0]).all() and (result.positions <= bounds[:, 1]).all()
+
+
+def test_bounds_are_validated_with_the_expected_and_the_given_shape():
+    """Shape, finiteness and low < high: INVALID_REQUEST saying what was wrong."""
+    assert checked_bounds(None, 2) is None
+    cases = [([0.0, 1.0, 0.0, 1.0], 'must have shape (d, 2) = (2, 2), one [min, max] per axis; '
+              'got shape (4,)'),
+             ([[0, 1], [0, 1], [0, 1]], 'shape (d, 2) = (2, 2), one [min, max] per axis; got '
+              'shape (3, 2)'),
+             ([[0, 1], [0, np.inf]], 'bounds must be finite; y_max is inf'),
+             ([[0, 1], [2, 2]], 'bounds: y_min = 2 must be below y_max = 2'),
+             ([[3, 1], [0, 1]], 'bounds: x_min = 3 must be below x_max = 1'),
+             ([['a', 'b'], [0, 1]], 'bounds must be real numbers')]
+    for bounds, words in cases:
+        with pytest.raises(PlanningError) as error:
+            Workspace(np.zeros((0, 2)), bounds=bounds)
+        assert error.value.code == ErrorCode.INVALID_REQUEST
+        assert words in str(error.value), str(error.value)
+    with pytest.raises(PlanningError, match=r'x3_min = 1 must be below x3_max = 0'):
+        checked_bounds([[0, 1]] * 3 + [[1, 0]], 4)
+
+
+def test_outside_workspace_ranks_beside_robot_on_obstacle_and_clearance_below_required():
+    """Input: after 10 and 11 (a pillar: after 9); plan: after 12; the first C_m is named."""
+    bounds = np.array([[-4.0, 4.0], [-4.0, 4.0]])
+    inside = np.array([[[-2.0, -2.0], [2.0, 2.0]], [[2.0, -2.0], [-2.0, 2.0]]])
+    obstacles = np.array([[0.0, 0.0]])
+
+    def code(configurations, **options):
+        try:
+            plan(Workspace(options.pop('obstacles', obstacles), bounds=bounds, **options),
+                 configurations)
+        except PlanningError as error:
+            return error
+        return None
+
+    out = inside.copy()
+    out[1, 0] = [5.0, 0.0]
+    out[0, 1] = [-4.5, 3.0]
+    first = code(out)
+    assert first.code == ErrorCode.OUTSIDE_WORKSPACE and first.configuration == 0
+    assert first.robots == (1,) and first.wall == Wall(0, False) and first.distance == 0.5
+    coincide = out.copy()
+    coincide[1, 1] = coincide[1, 0]
+    assert code(coincide).code == ErrorCode.ROBOTS_COINCIDE
+    on = out.copy()
+    on[1, 1] = obstacles[0]
+    assert code(on).code == ErrorCode.ROBOT_ON_OBSTACLE
+    degenerate = np.array([[9.0, 0.0], [9.0, 0.0]])
+    assert code(inside, obstacles=degenerate).code == ErrorCode.OBSTACLES_DEGENERATE
+    pillar = code(inside, obstacles=np.array([[9.0, 0.0]]))
+    assert pillar.code == ErrorCode.OUTSIDE_WORKSPACE and pillar.obstacle == 0
+    assert pillar.distance == 5.0 and pillar.wall == Wall(0, True)
+    # before any plan: an input outside comes before a clearance that would be too low
+    assert code(out, required_clearance=1e9).code == ErrorCode.OUTSIDE_WORKSPACE
+    # after planning: a plan below the required clearance is refused first
+    tight = np.array([[-2.01, 2.01], [-2.01, 2.01]])
+    raw = plan(Workspace(obstacles), inside)
+    assert (raw.positions < tight[:, 0]).any() or (raw.positions > tight[:, 1]).any()
+    with pytest.raises(PlanningError) as error:
+        plan(Workspace(obstacles, required_clearance=1e9, bounds=tight), inside)
+    assert error.value.code == ErrorCode.CLEARANCE_BELOW_REQUIRED
+    with pytest.raises(PlanningError) as error:
+        plan(Workspace(obstacles, bounds=tight), inside)
+    assert error.value.code == ErrorCode.OUTSIDE_WORKSPACE and error.value.leg is not None
+    assert error.value.distance == pytest.approx(
+        max((raw.positions - tight[:, 1]).max(), (tight[:, 0] - raw.positions).max()))
