@@ -27,6 +27,12 @@ slack: the caps are exactly those of every pair, so no pair enters or leaves
 the checked set in effect; every quantity is a continuous function of the input, and the number of
 blocks, sweeps and knots is fixed, so the map stays continuous on every domain
 (doc/design.md section 14).
+
+With walls (Bodies.bounds) each robot's change along each axis is kept within
+half its slack to the wall behind it (0 where it is beyond that wall), and
+where a knot's hat reaches beyond a wall the block starts from a pull
+inwards: the motion never reaches farther beyond a wall than the
+construction's, and a motion inside stays inside (doc/design.md section 14).
 """
 
 from dataclasses import dataclass
@@ -34,6 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .certificate import certify, segment_minimum
+from .walls import wall_slack
 
 # Knots per segment: the field is piecewise linear on the j / KNOTS fractions.
 KNOTS = 64
@@ -74,13 +81,16 @@ class Bodies:
     """
     What the gaps are measured against: pillars (r, d), radii (k + r,), the margin g0.
 
-    rounding is the slack treated as none (the resolution of the coordinates).
+    rounding is the slack treated as none (the resolution of the coordinates);
+    bounds, None or (d, 2) lows and highs of the workspace's walls in the
+    motion's coordinates, which every robot's centre keeps its radius inside.
     """
 
     obstacles: np.ndarray
     radii: np.ndarray
     margin: float
     rounding: float
+    bounds: np.ndarray | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -302,12 +312,40 @@ class _Caps:
             cap = np.minimum(2 * step, PILLAR_SHARE * np.maximum(slack, 0.0))
             np.minimum.at(pillar, (interval, robot), cap)
         self.pair, self.pillar = _knot_caps(pair), _knot_caps(pillar)
+        self.lower = self.upper = self.inward = None
+        if bodies.bounds is not None:
+            self._walls(low, high, bodies, step)
+
+    def _walls(self, low, high, bodies, step):
+        """
+        Add the walls: per axis, how far each knot may move down and up, and its pull inwards.
+
+        The signed distance to a wall is linear along a leg, so each box's
+        faces give the exact smallest wall slack of an interval. A robot may
+        move along each axis by half of its slack from the wall behind it over
+        its hat (0 where it is beyond that wall); inward (N, k, d) is, per axis,
+        how far the hat reaches beyond the low wall minus how far beyond the
+        high one: 0 inside (design, 14).
+        """
+        keep = bodies.radii[0] + bodies.rounding
+        # (N - 1, k, d): the lowest corner's slack to each wall min, the highest's to each max.
+        slacks = [wall_slack(np.moveaxis(corner, 0, 2), bodies.bounds, keep)[..., side]
+                  for side, corner in enumerate((low, high))]
+        self.lower, self.upper = (
+            _knot_caps(np.minimum(2 * step, PILLAR_SHARE * np.maximum(slack, 0.0)))
+            for slack in slacks)
+        below, above = (_knot_caps(np.maximum(-slack, 0.0), np.maximum) for slack in slacks)
+        self.inward = below - above
 
 
-def _knot_caps(bound):
-    """Return (N, k) caps from interval bounds (N - 1, k): both intervals of each hat."""
-    caps = np.zeros((bound.shape[0] + 1, bound.shape[1]))
-    caps[1:-1] = np.minimum(bound[:-1], bound[1:])
+def _knot_caps(bound, reduce=np.minimum):
+    """
+    Return (N, ...) caps from interval bounds (N - 1, ...): both intervals of each hat.
+
+    reduce np.maximum gives the larger of the two (how far a hat reaches out).
+    """
+    caps = np.zeros((bound.shape[0] + 1,) + bound.shape[1:])
+    caps[1:-1] = reduce(bound[:-1], bound[1:])
     caps[::KNOTS] = 0.0  # the configurations hold
     return caps
 
@@ -341,6 +379,7 @@ class _Block:
         self.common_cap = np.minimum(np.minimum(0.5 * caps.pillar.min(axis=1), step),
                                      _TRANSLATION * caps.pair.min(axis=1))
         self.pair, self.pillar, self.step = caps.pair, caps.pillar, step
+        self.lower, self.upper = caps.lower, caps.upper
 
     def clip(self, wanted):
         """
@@ -349,9 +388,14 @@ class _Block:
         common is the fleet's mean, clipped; own what each robot still wants, clipped.
         """
         common = _clipped(wanted.mean(axis=1), self.common_cap)
+        if self.lower is not None:
+            # Within every robot's wall limits, so each robot's own part has room around 0.
+            common = np.clip(common, -self.lower.min(axis=1), self.upper.min(axis=1))
         left = self.pillar - _length(common)[:, None]
         own = _clipped(wanted - common[:, None], np.minimum(np.minimum(self.pair, left),
                                                             self.step))
+        if self.lower is not None:
+            own = np.clip(own, -self.lower - common[:, None], self.upper - common[:, None])
         return common, own
 
 
@@ -404,15 +448,18 @@ def refine(times: np.ndarray, positions: np.ndarray, waypoint_indices: np.ndarra
     knots = _Knots.of(union, knot_grid)
     gap = certify(union.times, union.positions, bodies.obstacles,
                   bodies.radii if np.any(bodies.radii > 0) else None).distance
-    bodies = Bodies(bodies.obstacles, bodies.radii, min(bodies.margin, gap), bodies.rounding)
+    bodies = Bodies(bodies.obstacles, bodies.radii, min(bodies.margin, gap), bodies.rounding,
+                    bodies.bounds)
     scale = fleet_scale(configurations, bodies.obstacles)
     base_knots = union.positions[knots.points]
     values = np.zeros((knots.times.size, k, d))
     motion = union.positions
     step = STEP * scale
     for _ in range(block_count(k)):
-        block = _Block(_Caps(motion, knots, bodies, step), step)
-        common, own = np.zeros((values.shape[0], d)), np.zeros_like(values)
+        caps = _Caps(motion, knots, bodies, step)
+        block = _Block(caps, step)
+        common, own = ((np.zeros((values.shape[0], d)), np.zeros_like(values))
+                       if caps.inward is None else block.clip(caps.inward))
         for _ in range(SWEEPS):
             common, own = _sweep(values, common, own, base_knots, block)
         values = values + common[:, None] + own
