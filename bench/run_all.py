@@ -18,6 +18,7 @@ import time
 import core_speed
 from core_speed import format_table
 import discs
+import hall
 import numpy as np
 import peers
 import refinement
@@ -125,7 +126,7 @@ def service_sweep(quick):
 
 
 def write_markdown(figures, outcomes, settings, seconds, stages, profiles, service, disc_lines,
-                   refinement_lines):
+                   refinement_lines, hall_lines):
     """Write bench/results.md."""
     by = {
         'k': lambda q: q.k, 'kind': lambda q: q.kind, 'd': lambda q: q.d,
@@ -164,6 +165,8 @@ def write_markdown(figures, outcomes, settings, seconds, stages, profiles, servi
               *disc_lines, '']
     parts += ['## The refinement (issue 18)', '',
               refinement.__doc__.strip().split('\n\n')[1], '', *refinement_lines, '']
+    parts += ['## Workspace bounds: fleets in a hall (issue 19)', '',
+              hall.__doc__.strip().split('\n\n')[1], '', *hall_lines, '']
     parts += ['## Service round trip over DDS against k', '',
               'planner_node in its own process, one client, Fast DDS on this machine '
               '(`bench/service_roundtrip.py --sweep`); most of the time at large k is '
@@ -242,11 +245,13 @@ def main(argv=None):
     print('==> the refinement against the construction and OMPL', file=sys.stderr, flush=True)
     refinement_lines = refinement.report(refinement.quick_settings() if args.quick
                                          else refinement.Settings())
+    print('==> workspace bounds: fleets in a hall', file=sys.stderr, flush=True)
+    hall_lines = hall.report(hall.quick_settings() if args.quick else hall.Settings())
     print('==> service round trip over DDS', file=sys.stderr, flush=True)
     service = service_sweep(args.quick)
     seconds = time.perf_counter() - start
     write_markdown(figures, outcomes, settings, seconds, stages, profiles, service,
-                   disc_lines, refinement_lines)
+                   disc_lines, refinement_lines, hall_lines)
     write_plot(figures, outcomes)
     print('\n'.join(headline(figures, outcomes)))
     print()
@@ -259,6 +264,8 @@ def main(argv=None):
     print('\n'.join(disc_lines))
     print()
     print('\n'.join(refinement_lines))
+    print()
+    print('\n'.join(hall_lines))
     print()
     print(service)
     print(f'\nwrote {RESULTS_MD} and {RESULTS_PNG} in {seconds / 60:.1f} min')

@@ -4,6 +4,7 @@ import math
 import os
 
 from conftest import REPO_ROOT
+import numpy as np
 from punctured_planner.ros.parameters import FRAME_ID
 from punctured_planner.ros.parameters import load_parameter_file
 from punctured_planner.ros.settings import EXECUTOR
@@ -32,6 +33,35 @@ def test_values_take_the_parameter_kinds():
 def test_settings_validation_gives_reasons(values, words):
     with pytest.raises(ValueError, match=words):
         PLANNER.settings(values)
+
+
+@pytest.mark.parametrize('values', [
+    [0.0, 1.0, 0.0], [0.0, 1.0, 2.0, 1.0], [0.0, 1.0, 0.0, 1.0, 0.0, 1.0],
+    [2.0, 1.0, 0.0, 1.0], [5.0, 5.0, 0.0, 1.0],
+])
+def test_workspace_bounds_are_refused_exactly_where_the_core_refuses_them(values):
+    """One rule: the parameter's reason is the core's, with the parameter and its axes."""
+    from punctured_planner.core import PlanningError
+    from punctured_planner.core.walls import checked_bounds
+    flat = np.asarray(values)
+    with pytest.raises(PlanningError) as core:
+        checked_bounds(flat.reshape(-1, 2) if flat.size % 2 == 0 else flat, 2)
+    with pytest.raises(ValueError) as parameter:
+        PLANNER.settings({'workspace_bounds': values})
+    reason = str(parameter.value)
+    assert reason.startswith('workspace_bounds [') and core.value.args[0] in reason
+    assert 'for dimension 2 (x_min, x_max, y_min, y_max)' in reason
+
+
+def test_workspace_bounds_become_the_cores_box_for_the_dimension():
+    """Empty: no walls; 4 values in the plane, 6 in 3-D, each axis [min, max]."""
+    assert PLANNER.settings({}).core_bounds is None
+    planar = PLANNER.settings({'workspace_bounds': [-1, 2, 0, 3.5]}).core_bounds
+    assert planar.tolist() == [[-1.0, 2.0], [0.0, 3.5]]
+    spatial = PLANNER.settings({'dimension': 3, 'workspace_bounds': [0, 1, 0, 2, -1, 0]})
+    assert spatial.core_bounds.tolist() == [[0.0, 1.0], [0.0, 2.0], [-1.0, 0.0]]
+    with pytest.raises(ValueError, match=r'\(x_min, x_max, y_min, y_max, z_min, z_max\)'):
+        PLANNER.settings({'dimension': 3, 'workspace_bounds': [0, 1, 0, 2]})
 
 
 def test_parameter_files(tmp_path):

@@ -226,6 +226,31 @@ def test_every_error_code_and_the_node_keeps_serving(planner, ros_client, monkey
     node.set_parameters(required_clearance=0.0)
     valid()
 
+    # walls 0.5 beyond the inputs' box: a robot or a pillar outside, a plan that leaves
+    box = [-3.5, 4.0, -3.0, 4.0]
+    assert all(r.successful for r in node.set_parameters(workspace_bounds=box))
+    expect(make_request([c1, moved(c2, 3, [4.25, 1.0, 0.0])]), codes.OUTSIDE_WORKSPACE,
+           'configuration 1: robot 3 is 0.25 beyond the wall x_max = 4 (centre x = 4.25)')
+    expect(make_request([c1, moved(c2, 3, [4.25, 1.0, 0.0]), moved(c3, 0, OBSTACLES[1])]),
+           codes.ROBOT_ON_OBSTACLE, 'configuration 2', 'robot 0')  # it ranks before
+    node.set_parameters(obstacles=flat(OBSTACLES[:2] + [[2.5, -3.5, 0.0]]))
+    expect(make_request(), codes.OUTSIDE_WORKSPACE,
+           'obstacle 2 at (2.5, -3.5, 0) (from the parameter) is 0.5 beyond the wall y_min = -3')
+    node.set_parameters(obstacles=flat(OBSTACLES))
+    from punctured_planner.core import plan, PlanningError, Workspace
+    with pytest.raises(PlanningError) as leaves:  # the construction's lanes leave the box
+        plan(Workspace(np.array(OBSTACLES)[:, :2], variant='spread',
+                       bounds=np.reshape(box, (2, 2))), np.array(CONFIGURATIONS)[..., :2],
+             refine=False)
+    assert leaves.value.leg is not None and leaves.value.distance > 0
+    node.set_parameters(refine=False)
+    expect(make_request(), codes.OUTSIDE_WORKSPACE,
+           'the plan takes robot %d %.6g beyond the wall %s' % (
+               leaves.value.robots[0], leaves.value.distance, leaves.value.wall.name),
+           'on leg %d (' % leaves.value.leg)
+    node.set_parameters(workspace_bounds=[], refine=True)
+    valid()
+
     import punctured_planner.core as core
 
     def broken(*args, **kwargs):
@@ -298,7 +323,7 @@ def test_parameter_changes_take_effect_and_bad_values_are_refused(planner, ros_c
         'dimension': 4, 'variant': 'fast', 'lane_spacing': -1.0, 'min_spacing': math.nan,
         'max_speed': 'quick', 'obstacles': [1.0, 2.0], 'robot_names': ['a', 'a'],
         'robot_count': 3, 'frame_id': '', 'plane_z': math.inf, 'samples_per_leg': -1,
-        'required_clearance': -0.5, 'max_robots': 2,
+        'required_clearance': -0.5, 'max_robots': 2, 'workspace_bounds': [0.0, 1.0, 2.0],
     }
     for name, value in refused.items():
         before = node.node.get_parameter(name).value
@@ -332,6 +357,23 @@ def test_parameters_over_the_parameter_service(planner, ros_client):
     described = result(remote.describe_parameters(['lane_spacing', 'dimension'])).descriptors
     assert described[0].description and described[0].floating_point_range
     assert described[1].integer_range[0].to_value == 3
+
+    # workspace_bounds: the core's rule, for the node's dimension, and the reason said
+    answer = result(remote.set_parameters([Parameter('workspace_bounds',
+                                                     value=[0.0, 5.0, 3.0, 1.0])]))
+    assert not answer.results[0].successful
+    assert 'y_min = 3 must be below y_max = 1' in answer.results[0].reason
+    answer = result(remote.set_parameters([Parameter('workspace_bounds',
+                                                     value=[0.0, 5.0, 0.0, 1.0, 0.0, 1.0])]))
+    assert not answer.results[0].successful
+    assert 'shape (d, 2) = (2, 2)' in answer.results[0].reason
+    answer = result(remote.set_parameters([Parameter('workspace_bounds',
+                                                     value=[-1.0, 5.0, 0.0, 1.5])]))
+    assert answer.results[0].successful
+    assert node.node.snapshot().settings.core_bounds.tolist() == [[-1.0, 5.0], [0.0, 1.5]]
+    described = result(remote.describe_parameters(['workspace_bounds'])).descriptors[0]
+    assert 'OUTSIDE_WORKSPACE' in described.description
+    assert described.additional_constraints
 
 
 def test_odometry_assembles_the_current_state(planner, ros_client):

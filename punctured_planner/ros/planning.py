@@ -6,7 +6,7 @@ snapshot of its subscriptions and parameters, ``punctured-planner plan`` calls
 it offline with a parameter file. :meth:`PlanSequenceHandler.handle` runs
 named steps that return values, as nav2's computePlan: gather and check
 (:mod:`punctured_planner.ros.checks`, codes 1-8 in priority order), plan (the
-core: codes 9-12) and answer (paths and response). Every PlanningError they
+core: codes 9-13) and answer (paths and response). Every PlanningError they
 raise is worded (:mod:`punctured_planner.ros.wording`) and becomes the
 response's error code in one place, :meth:`PlanSequenceHandler.handle`.
 """
@@ -51,7 +51,7 @@ class PlanSequenceHandler:
         obstacles = np.ascontiguousarray(obstacles, dtype=float)
         key = (obstacles.shape, obstacles.tobytes(), settings.dimension, settings.core_variant,
                settings.lane_spacing, settings.min_spacing, settings.required_clearance,
-               settings.robot_radius, settings.obstacle_radius)
+               settings.robot_radius, settings.obstacle_radius, settings.workspace_bounds)
         with self._lock:
             found = self._cache.get(key)
             if found is not None:
@@ -62,7 +62,8 @@ class PlanSequenceHandler:
                               variant=settings.core_variant, min_spacing=settings.min_spacing,
                               required_clearance=settings.required_clearance,
                               robot_radius=settings.robot_radius,
-                              obstacle_radius=settings.core_obstacle_radius)
+                              obstacle_radius=settings.core_obstacle_radius,
+                              bounds=settings.core_bounds)
         with self._lock:
             self._cache[key] = workspace
             while len(self._cache) > self._cache_size:

@@ -23,6 +23,8 @@ from .parameters import Spec
 from .parameters import Table
 from .parameters import within
 from ..core import VARIANTS
+from ..core.walls import checked_bounds
+from ..core.walls import Wall
 from ..execution import Bodies
 from ..execution import DRIVES
 from ..execution import ExecutionSettings
@@ -79,6 +81,12 @@ class PlannerSettings:
         'required_clearance', 'double', 0.0,
         'Refuse a plan whose certified minimum clearance is below this (m); 0 accepts '
         'every collision-free plan.', low=0.0, high=1e6).field()
+    workspace_bounds: tuple = Spec(
+        'workspace_bounds', 'double_array', [],
+        'Walls of the workspace (m), in frame_id: [x_min, x_max, y_min, y_max] for '
+        'dimension 2, then z_min, z_max for 3; every robot (its disc) and pillar must stay '
+        'inside, inputs and plans outside are refused (OUTSIDE_WORKSPACE); empty: no walls.',
+        prose='empty, or a min below its max for each of the dimension axes; finite').field()
     refine: bool = Spec(
         'refine', 'bool', True,
         "Refine the construction's motion (doc/design.md section 14): shorter, in the "
@@ -131,6 +139,19 @@ class PlannerSettings:
         return self.obstacle_radius
 
     @property
+    def core_bounds(self) -> np.ndarray | None:
+        """
+        Return workspace_bounds as the core's (d, 2) [min, max] per axis, or None.
+
+        An odd count of values stays flat: the core's check then says which
+        shape it expected and which it got.
+        """
+        if not self.workspace_bounds:
+            return None
+        values = np.asarray(self.workspace_bounds, dtype=float)
+        return values.reshape(-1, 2) if values.size % 2 == 0 else values
+
+    @property
     def expected_robot_count(self) -> int:
         """Return the robot count requests must have, or 0 when any count is fine."""
         return len(self.robot_names) or self.robot_count
@@ -147,7 +168,20 @@ def _planner_robot_count(settings: PlannerSettings) -> None:
                          % (settings.expected_robot_count, settings.max_robots))
 
 
-PLANNER = Table('planner_node', PlannerSettings, checks=(_planner_robot_count,))
+def _planner_bounds(settings: PlannerSettings) -> None:
+    """Refuse workspace_bounds the core refuses (its one rule), or a count not 2 per axis."""
+    try:
+        checked_bounds(settings.core_bounds, settings.dimension)
+    except ValueError as error:  # a PlanningError: its reason without the code
+        raise ValueError('workspace_bounds %r for dimension %d (%s): %s'
+                         % (list(settings.workspace_bounds), settings.dimension,
+                            ', '.join(Wall(axis, high).name for axis in range(settings.dimension)
+                                      for high in (False, True)),
+                            error.args[0])) from None
+
+
+PLANNER = Table('planner_node', PlannerSettings,
+                checks=(_planner_robot_count, _planner_bounds))
 
 
 def _drives(name: str, value: tuple) -> None:

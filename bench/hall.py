@@ -1,0 +1,161 @@
+"""
+Workspace bounds (issue 19): how many realistic fleets plan inside the walls of a hall.
+
+Hidden hall fleets: bench/refinement.py's realistic disc fleets (R = 0.2 m, pillars of
+rho = 0.15 m, robots covering 6% of the floor, centres at least 4R apart, n = 3
+configurations, variant 'discs', refined and certified), on seeds no other
+benchmark uses. The walls are the box of all configurations and pillars plus a
+margin of 15% of its longest side on every side. Each request either comes back
+inside the walls (checked here again, independently: every breakpoint's disc
+inside) or is refused with OUTSIDE_WORKSPACE; the benchmark asserts that nothing
+comes back outside. Figures per k: the share planned inside, the share refused,
+any other refusal, and for the refused the median distance beyond the wall as a
+share of the box's longest side.
+
+Run alone: ``.venv/bin/python bench/hall.py [--quick]``.
+"""
+
+import argparse
+from dataclasses import dataclass
+import sys
+import time
+
+from core_speed import format_table
+import numpy as np
+from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
+from refinement import PILLAR, RADIUS, realistic_fleet
+
+MARGIN = 0.15
+# Seeds of the hidden fleets: far from bench/refinement.py's 100 k + 10 d + seed.
+SEED_BASE = 7_000_003
+
+
+@dataclass
+class Outcome:
+    """One fleet in its hall: planned inside, or the refusal's code and distance."""
+
+    k: int
+    code: ErrorCode
+    beyond: float = float('nan')
+    seconds: float = float('nan')
+
+
+def hall(fleet) -> np.ndarray:
+    """Return the (d, 2) walls: the box of configurations and pillars, MARGIN x side beyond."""
+    points = np.concatenate([fleet.configurations.reshape(-1, fleet.d), fleet.pillars])
+    low, high = points.min(axis=0), points.max(axis=0)
+    margin = MARGIN * float((high - low).max())
+    return np.stack([low - margin, high + margin], axis=1)
+
+
+def inside(positions: np.ndarray, bounds: np.ndarray) -> bool:
+    """
+    Return whether every disc of positions (V, k, d) is inside bounds: a check of its own.
+
+    Plain floating point, so up to 1e-12 of the hall's scale (the core's check
+    has the exact sign and may accept a disc exactly touching a wall).
+    """
+    rounding = 1e-12 * float(np.abs(bounds).max())
+    return bool((positions - bounds[:, 0] - RADIUS >= -rounding).all()
+                and (bounds[:, 1] - positions - RADIUS >= -rounding).all())
+
+
+def run_one(fleet) -> Outcome:
+    """Plan one fleet in its hall; assert a returned plan is inside."""
+    bounds = hall(fleet)
+    side = float((bounds[:, 1] - bounds[:, 0]).max()) / (1 + 2 * MARGIN)
+    workspace = Workspace(fleet.pillars, variant='discs', robot_radius=RADIUS,
+                          obstacle_radius=PILLAR, bounds=bounds)
+    begin = time.perf_counter()
+    try:
+        result = plan(workspace, fleet.configurations)
+    except PlanningError as error:
+        beyond = error.distance / side if error.code == ErrorCode.OUTSIDE_WORKSPACE else np.nan
+        return Outcome(fleet.k, error.code, beyond, time.perf_counter() - begin)
+    seconds = time.perf_counter() - begin
+    assert inside(result.positions, bounds), f'k={fleet.k} seed={fleet.seed}: came back outside'
+    return Outcome(fleet.k, ErrorCode.NONE, 0.0, seconds)
+
+
+@dataclass
+class Settings:
+    """Fleet sizes (d = 2) and seeds per size."""
+
+    ks: tuple = (3, 5, 8, 10, 20, 40, 100)
+    seeds: int = 20
+    large_seeds: int = 5
+    seed_base: int = SEED_BASE
+
+
+def quick_settings() -> Settings:
+    """Return a smoke-run grid."""
+    return Settings(ks=(3, 8, 20), seeds=3, large_seeds=1)
+
+
+def run(settings: Settings, progress=None) -> list[Outcome]:
+    """Return the Outcome of every fleet of the grid."""
+    outcomes = []
+    for k in settings.ks:
+        for seed in range(settings.seeds if k <= 40 else settings.large_seeds):
+            fleet = realistic_fleet(k, 2, settings.seed_base + 1000 * k + seed)
+            if fleet is None:
+                continue
+            if progress:
+                progress(f'k={k} seed={seed}')
+            outcomes.append(run_one(fleet))
+    return outcomes
+
+
+def _share(outcomes, code) -> str:
+    """Return the share of outcomes with code, as 'p% (count)'."""
+    count = sum(o.code == code for o in outcomes)
+    return f'{100 * count / max(len(outcomes), 1):.0f}% ({count})'
+
+
+def table(outcomes: list[Outcome]) -> list[tuple]:
+    """Return the rows per k: shares planned inside, refused outside, refused otherwise."""
+    rows = [('k', 'fleets', 'planned inside', 'refused OUTSIDE_WORKSPACE', 'other refusals',
+             'beyond the wall / side, median (refused)', 'plan ms, median')]
+    for k in sorted({o.k for o in outcomes}):
+        group = [o for o in outcomes if o.k == k]
+        others = [o.code.name for o in group
+                  if o.code not in (ErrorCode.NONE, ErrorCode.OUTSIDE_WORKSPACE)]
+        beyond = [o.beyond for o in group if o.code == ErrorCode.OUTSIDE_WORKSPACE]
+        rows.append((str(k), str(len(group)), _share(group, ErrorCode.NONE),
+                     _share(group, ErrorCode.OUTSIDE_WORKSPACE),
+                     ', '.join(others) or '0',
+                     f'{100 * np.median(beyond):.0f}%' if beyond else '-',
+                     f'{1e3 * np.median([o.seconds for o in group]):.1f}'))
+    return rows
+
+
+def summary(outcomes: list[Outcome]) -> list[str]:
+    """Return the headline: issue 19's target (>= 90% inside for k <= 40) against this run."""
+    small = [o for o in outcomes if o.k <= 40]
+    planned = sum(o.code == ErrorCode.NONE for o in small)
+    return [
+        f'- Hall fleets k <= 40 planned inside the walls (15% margin): '
+        f'{100 * planned / max(len(small), 1):.0f}% of {len(small)} (target >= 90%); every '
+        f'other one refused, none returned outside (asserted).',
+    ]
+
+
+def report(settings: Settings) -> list[str]:
+    """Run the benchmark; return its Markdown lines: the headline, then the table."""
+    start = time.perf_counter()
+    outcomes = run(settings, lambda label: print(
+        f'{time.perf_counter() - start:7.1f} s  {label}', file=sys.stderr, flush=True))
+    return summary(outcomes) + ['', format_table(table(outcomes))]
+
+
+def main(argv=None):
+    """Run the benchmark and print its figures."""
+    parser = argparse.ArgumentParser(description=__doc__.strip().splitlines()[0])
+    parser.add_argument('--quick', action='store_true', help='a small grid (smoke run)')
+    args = parser.parse_args(argv)
+    print('\n'.join(report(quick_settings() if args.quick else Settings())))
+    sys.stdout.flush()
+
+
+if __name__ == '__main__':
+    main()
