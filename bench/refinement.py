@@ -15,9 +15,6 @@ change of the motion as a function of normalised time, over the move). OMPL
 RRTConnect (2 s per segment) with path simplification (1 s) plans the same
 fleets for small k (it does not solve larger ones in its budget), its discs
 validity check in Python; its time is given with and without that checker.
-Hall fleets (issue 19): the same fleets with walls at the box of
-configurations and pillars plus HALL_MARGIN of its side; the share planned
-inside the walls (the rest is refused OUTSIDE_WORKSPACE, never returned).
 
 Run alone: ``.venv/bin/python bench/refinement.py [--quick]``.
 """
@@ -38,8 +35,6 @@ RADIUS, PILLAR = 0.2, 0.15
 COVERAGE = 0.06
 MIN_HALL = 4.0
 PERTURBATION = 1e-7
-HALL_MARGIN = 0.15
-HALL_KS = (3, 5, 8, 10, 20, 40, 100)
 RAW, REFINED, RRT = 'construction', 'refined', 'OMPL RRTConnect + simplify'
 
 
@@ -174,40 +169,6 @@ def run_rrt(fleet, budget, simplify_budget):
                   excursion(short, fleet), gap, 0.0, total, checking)
 
 
-def hall_bounds(fleet):
-    """Return the hall's walls (d, 2): the box of configurations and pillars, HALL_MARGIN more."""
-    points = np.concatenate([fleet.configurations.reshape(-1, fleet.d), fleet.pillars])
-    low, high = points.min(axis=0), points.max(axis=0)
-    spare = HALL_MARGIN * float((high - low).max())
-    return np.stack([low - spare, high + spare], axis=1)
-
-
-def plans_inside(fleet):
-    """Return the refusal's error code name of the fleet in its hall, or '' if it planned."""
-    workspace = Workspace(fleet.pillars, variant='discs', robot_radius=RADIUS,
-                          obstacle_radius=PILLAR, bounds=hall_bounds(fleet))
-    try:
-        plan(workspace, fleet.configurations)
-    except PlanningError as error:
-        return error.code.name
-    return ''
-
-
-def hall_lines(settings):
-    """Return a line per k: the share of hall fleets planned inside their walls."""
-    lines = []
-    for k in settings.hall_ks:
-        outcomes = [plans_inside(fleet) for fleet in (
-            realistic_fleet(k, 2, 100 * k + 20 + seed)
-            for seed in range(settings.seeds if k <= 40 else settings.large_seeds))
-            if fleet is not None]
-        refusals = sorted({code for code in outcomes if code})
-        lines.append(f'- Hall fleets, k = {k}: {outcomes.count("")} of {len(outcomes)} planned '
-                     f'inside the walls' + (f' (refused: {", ".join(refusals)})'
-                                            if refusals else '') + '.')
-    return lines
-
-
 @dataclass
 class Settings:
     """What to run: fleet sizes per dimension, seeds, OMPL's fleets and budgets."""
@@ -221,14 +182,12 @@ class Settings:
     rrt_seeds: int = 3
     rrt_budget: float = 2.0
     simplify_budget: float = 1.0
-    hall_ks: tuple = HALL_KS
 
 
 def quick_settings():
     """Return a smoke-run grid."""
     return Settings(ks={2: (5, 20), 3: (5,)}, seeds=2, large_seeds=1, continuity_seeds=1,
-                    rrt_ks=(5,), rrt_seeds=1, rrt_budget=0.5, simplify_budget=0.2,
-                    hall_ks=(5,))
+                    rrt_ks=(5,), rrt_seeds=1, rrt_budget=0.5, simplify_budget=0.2)
 
 
 def run(settings, progress=None):
@@ -341,7 +300,7 @@ def report(settings):
     start = time.perf_counter()
     results = run(settings, lambda label: print(
         f'{time.perf_counter() - start:7.1f} s  {label}', file=sys.stderr, flush=True))
-    return summary(results) + hall_lines(settings) + ['', format_table(table(results))]
+    return summary(results) + ['', format_table(table(results))]
 
 
 def main(argv=None):
