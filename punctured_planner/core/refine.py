@@ -380,6 +380,9 @@ class _Block:
                                      _TRANSLATION * caps.pair.min(axis=1))
         self.pair, self.pillar, self.step = caps.pair, caps.pillar, step
         self.lower, self.upper = caps.lower, caps.upper
+        if self.lower is not None:
+            # The common part stays within every robot's range along each axis.
+            self.common_range = (-self.lower.min(axis=1), self.upper.min(axis=1))
 
     def clip(self, wanted):
         """
@@ -390,7 +393,7 @@ class _Block:
         common = _clipped(wanted.mean(axis=1), self.common_cap)
         if self.lower is not None:
             # Within every robot's wall limits, so each robot's own part has room around 0.
-            common = np.clip(common, -self.lower.min(axis=1), self.upper.min(axis=1))
+            common = np.clip(common, *self.common_range)
         left = self.pillar - _length(common)[:, None]
         own = _clipped(wanted - common[:, None], np.minimum(np.minimum(self.pair, left),
                                                             self.step))
