@@ -21,10 +21,8 @@ smallest robot-pillar slack; each knot's total move in the block is split into
 the fleet's common translation (which robot pairs do not feel) and each
 robot's own part, each clipped to its caps and to a fixed step. Gap distance
 is 1-Lipschitz in each robot's position, so no gap falls below g0 (the caps
-lemma). A pair is evaluated exactly unless its bounding boxes over an interval
-are so far apart that its cap there is the fixed step whatever its exact
-slack: the caps are exactly those of every pair, so no pair enters or leaves
-the checked set in effect; every quantity is a continuous function of the input, and the number of
+lemma). Every pair is evaluated, so no pair enters or leaves the checked set;
+every quantity is a continuous function of the input, and the number of
 blocks, sweeps and knots is fixed, so the map stays continuous on every domain
 (doc/design.md section 14).
 
@@ -57,11 +55,8 @@ BLOCKS, SWEEPS = 12, 6
 # robots the blocks fall as FULL_ROBOTS / k, and beyond MAX_ROBOTS none is run (the
 # construction's plan is returned; k is fixed on a domain, so this keeps continuity).
 FULL_ROBOTS, MAX_ROBOTS = 64, 256
-# The longest move of a knot in one block, as a share of the fleet's scale. A pair whose
-# boxes over an interval are more than 4 steps of slack apart has the cap `step` there
-# whatever its exact slack, so it is not evaluated: a small step evaluates fewer pairs.
-# Measured (bench/refinement.py fleets): 0.05 shortens as much as 0.2, 0.02 less.
-STEP = 0.05
+# The longest move of a knot in one block, as a share of the fleet's scale.
+STEP = 0.2
 # Over-relaxation factor: about 2 / (1 + sin(pi / KNOTS)) is the classical optimum; less
 # is steadier under the caps.
 RELAXATION = 1.9
@@ -72,7 +67,8 @@ PAIR_SHARE, PILLAR_SHARE = 0.25, 0.5
 # (4: the smallest pair slack itself; more would make the caps steep, and continuity
 # weaker, for nothing but rounding).
 _TRANSLATION = 4.0
-# Entries (coordinate x leg of a candidate pair) of the slack arrays computed at once.
+# Entries (coordinate x leg x robot x robot or pillar) of the slack arrays computed at
+# once.
 _ENTRIES = 1 << 21
 
 
@@ -193,79 +189,43 @@ def _interval_boxes(planes, points):
     return low, high
 
 
-def _box_distances(first, second):
-    """Return the smallest distance of boxes first, second ((low, high), each (d, ...))."""
-    apart = np.maximum(np.maximum(first[0] - second[1], second[0] - first[1]), 0.0)
-    squared = apart[0] * apart[0]
-    for axis in range(1, apart.shape[0]):
-        squared = squared + apart[axis] * apart[axis]
-    return np.sqrt(squared)
-
-
-def _near_pairs(low, high, bound):
+def _interval_minima(planes, knots, pillars=None):
     """
-    Return (interval, a, b): the robot pairs whose boxes over an interval are < bound apart.
+    Return (N - 1, k, m) the exact smallest distance over each knot interval, densely.
 
-    Sweep and prune along e1 over all intervals at once: boxes sorted by
-    interval, then by their lower e1 end; box i meets only the boxes after it
-    in its interval whose lower end is <= its upper end + bound. Every other
-    pair is at least bound apart on that axis; the rest are kept if their
-    boxes' distance is below bound.
+    From every robot to every robot (m = k, the diagonal +inf) or, with pillars
+    (m, d), to every pillar: the closed form on every leg of the union, then
+    the minimum over each interval's legs. planes is the motion coordinate
+    first (d, U, k). Dense arrays over a few hundred legs cost less than
+    choosing pairs would; a run of whole intervals at a time bounds the
+    temporaries (the grouping does not change any value).
     """
-    intervals, k = low.shape[1:]
-    span = float(high[0].max() - low[0].min()) + bound + 1.0
-    # One sorted key per box: the interval, then the lower e1 end (each interval's keys
-    # lie in their own stretch of length span, so no box meets another interval's).
-    offset = np.arange(intervals)[:, None] * (2.0 * span) - low[0].min()
-    keys = (low[0] + offset).ravel()
-    order = np.argsort(keys, kind='stable')
-    ends = np.searchsorted(keys[order], (high[0] + offset + bound).ravel()[order],
-                           side='right')
-    counts = np.maximum(ends - np.arange(order.size) - 1, 0)
-    first = np.repeat(np.arange(order.size), counts)
-    later = first + 1 + np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
-    one, other = order[first], order[later]
-    interval, a = np.divmod(one, k)
-    b = other % k
-    near = _box_distances((low[:, interval, a], high[:, interval, a]),
-                          (low[:, interval, b], high[:, interval, b])) < bound
-    return interval[near], a[near], b[near]
-
-
-def _candidate_minima(planes, points, interval, a, b=None, pillars=None):
-    """
-    Return the exact smallest distance over each candidate's knot interval, (c,).
-
-    Candidate i is robot a[i] and robot b[i] (or pillar b[i] of pillars (r, d))
-    over knot interval interval[i]: the closed form on every leg of the union
-    in it, then the minimum over those legs. A run of candidates at a time
-    bounds the temporaries (the grouping does not change any value).
-    """
-    counts = np.diff(points)[interval]
-    result = np.empty(interval.size)
-    d = planes.shape[0]
-    limit = max(1, _ENTRIES // d)
-    ends = np.cumsum(counts)
+    d, _, k = planes.shape
+    # Robot pairs a < b only (np.take keeps the pairs last and contiguous), then mirrored.
+    a, b = np.triu_indices(k, 1)
+    width = a.size if pillars is None else k * pillars.shape[0]
+    points = knots.points
+    minima = np.empty((points.size - 1, width))
+    legs = max(1, _ENTRIES // (d * max(width, 1)))
     first = 0
-    while first < interval.size:
-        last = max(int(np.searchsorted(ends, ends[first] - counts[first] + limit,
-                                       side='right')), first + 1)
-        piece = counts[first:last]
-        offsets = np.cumsum(piece) - piece
-        legs = np.repeat(points[interval[first:last]], piece) + (
-            np.arange(int(piece.sum())) - np.repeat(offsets, piece))
-        robot = np.repeat(a[first:last], piece)
+    while first < minima.shape[0]:
+        last = int(np.searchsorted(points, points[first] + legs, side='right')) - 1
+        last = min(max(last, first + 1), minima.shape[0])
+        piece = planes[:, points[first]:points[last] + 1]
         if pillars is None:
-            other = np.repeat(b[first:last], piece)
-            begin = planes[:, legs, robot] - planes[:, legs, other]
-            stop = planes[:, legs + 1, robot] - planes[:, legs + 1, other]
+            relative = np.take(piece, a, axis=2) - np.take(piece, b, axis=2)
         else:
-            pillar = pillars.T[:, np.repeat(b[first:last], piece)]
-            begin = planes[:, legs, robot] - pillar
-            stop = planes[:, legs + 1, robot] - pillar
-        squared, _ = segment_minimum(begin, stop - begin)
-        result[first:last] = np.sqrt(np.minimum.reduceat(squared, offsets))
+            relative = (piece[:, :, :, None] - pillars.T[:, None, None, :]).reshape(
+                d, piece.shape[1], width)
+        squared, _ = segment_minimum(relative[:, :-1], relative[:, 1:] - relative[:, :-1])
+        minima[first:last] = np.sqrt(np.minimum.reduceat(
+            squared, points[first:last] - points[first], axis=0))
         first = last
+    if pillars is not None:
+        return minima.reshape(minima.shape[0], k, pillars.shape[0])
+    result = np.full((minima.shape[0], k, k), np.inf)
+    result[:, a, b] = minima
+    result[:, b, a] = minima
     return result
 
 
@@ -277,46 +237,29 @@ class _Caps:
     robot-pillar pair over each knot interval: a quarter (PAIR_SHARE) of the
     smallest pair slack, half (PILLAR_SHARE) of the smallest pillar slack, over
     the two intervals each knot's hat covers, at most step (2 step for a
-    pillar); 0 at the configurations (design, 14). A pair whose bounding boxes
-    over an interval are 4 step farther apart than its offset has a cap of
-    step (2 step) there whatever its exact slack, so only the others are
-    evaluated: the caps are exactly those of every pair.
+    pillar); 0 at the configurations (design, 14).
     """
 
     def __init__(self, motion, knots, bodies, step):
         """Compute the caps for the motion at the union's breakpoints (U, k, d)."""
-        points = knots.points
-        intervals, k = points.size - 1, motion.shape[1]
+        intervals, k = knots.points.size - 1, motion.shape[1]
         planes = np.ascontiguousarray(np.moveaxis(motion, 2, 0))
-        low, high = _interval_boxes(planes, points)
         floor = bodies.margin + bodies.rounding
-        reach = 4.0 * step
         pair = np.full((intervals, k), step)
         if k > 1:
-            offset = 2 * bodies.radii[0] + floor
-            interval, first, second = _near_pairs(low, high, offset + reach)
-            slack = _candidate_minima(planes, points, interval, first, second) - offset
-            cap = np.minimum(step, PAIR_SHARE * np.maximum(slack, 0.0))
-            np.minimum.at(pair, (interval, first), cap)
-            np.minimum.at(pair, (interval, second), cap)
+            slack = _interval_minima(planes, knots).min(axis=2) - 2 * bodies.radii[0] - floor
+            pair = np.minimum(pair, PAIR_SHARE * np.maximum(slack, 0.0))
         pillar = np.full((intervals, k), 2 * step)
-        obstacles = bodies.obstacles
-        if len(obstacles):
+        if len(bodies.obstacles):
             offsets = bodies.radii[:k, None] + bodies.radii[None, k:] + floor
-            column = obstacles.T[:, None, None, :]
-            near = _box_distances((low[..., None], high[..., None]),
-                                  (column, column)) < offsets + reach
-            interval, robot, index = np.nonzero(near)
-            slack = (_candidate_minima(planes, points, interval, robot, index, obstacles)
-                     - offsets[robot, index])
-            cap = np.minimum(2 * step, PILLAR_SHARE * np.maximum(slack, 0.0))
-            np.minimum.at(pillar, (interval, robot), cap)
+            slack = (_interval_minima(planes, knots, bodies.obstacles) - offsets).min(axis=2)
+            pillar = np.minimum(pillar, PILLAR_SHARE * np.maximum(slack, 0.0))
         self.pair, self.pillar = _knot_caps(pair), _knot_caps(pillar)
         self.lower = self.upper = self.inward = None
         if bodies.bounds is not None:
-            self._walls(low, high, bodies, step)
+            self._walls(_interval_boxes(planes, knots.points), bodies, step)
 
-    def _walls(self, low, high, bodies, step):
+    def _walls(self, boxes, bodies, step):
         """
         Add the walls: per axis, how far each knot may move down and up, and its pull inwards.
 
@@ -327,6 +270,7 @@ class _Caps:
         how far the hat reaches beyond the low wall minus how far beyond the
         high one: 0 inside (design, 14).
         """
+        low, high = boxes
         keep = bodies.radii[0] + bodies.rounding
         # (N - 1, k, d): the lowest corner's slack to each wall min, the highest's to each max.
         slacks = [wall_slack(np.moveaxis(corner, 0, 2), bodies.bounds, keep)[..., side]
