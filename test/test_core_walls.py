@@ -9,7 +9,7 @@ the priority of OUTSIDE_WORKSPACE among the other codes.
 
 from fractions import Fraction
 
-from core_strategies import requests
+from core_strategies import lattice_requests, requests
 from hypothesis import given, HealthCheck, settings, strategies as st
 import numpy as np
 from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
@@ -199,6 +199,38 @@ def test_a_plan_is_inside_its_bounds_or_refused_naming_where_it_leaves(
         assert f'robot {robot} ' in str(error) and f'on leg {leg} (' in str(error)
         return
     assert (result.positions >= bounds[:, 0]).all() and (result.positions <= bounds[:, 1]).all()
+
+
+@settings(max_examples=40, deadline=None,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+@given(lattice_requests(), st.sampled_from([0.0, 0.1, 0.5, 2.0]), st.booleans())
+def test_disc_plans_keep_their_radius_from_every_wall_or_are_refused(case, margin, refine):
+    """Discs: the walls margin beyond the discs of the inputs and pillars; R counts."""
+    workspace, configurations = case
+    radius, rho = workspace.robot_radius, workspace.obstacle_radii
+    low = np.minimum((configurations - radius).min(axis=(0, 1)),
+                     (workspace.obstacles - rho[:, None]).min(axis=0, initial=np.inf))
+    high = np.maximum((configurations + radius).max(axis=(0, 1)),
+                      (workspace.obstacles + rho[:, None]).max(axis=0, initial=-np.inf))
+    # margin 0 touches the outermost disc: a few ulps more, which low - R rounded away
+    rounding = 1e-12 * max(1.0, float(np.abs([low, high]).max()))
+    bounds = np.stack([low - margin - rounding, high + margin + rounding], axis=1)
+    walled = Workspace(workspace.obstacles, variant='discs', robot_radius=radius,
+                       obstacle_radius=rho, bounds=bounds)
+    try:
+        result = plan(walled, configurations, refine=refine)
+    except PlanningError as error:
+        assert error.code == ErrorCode.OUTSIDE_WORKSPACE, str(error)
+        free = plan(workspace, configurations, refine=refine).positions
+        leg, robot, wall = error.leg, error.robots[0], error.wall
+        ends = free[leg:leg + 2, robot, wall.axis]
+        beyond = (ends.max() + radius - bounds[wall.axis, 1] if wall.high
+                  else bounds[wall.axis, 0] - (ends.min() - radius))
+        assert beyond == pytest.approx(error.distance, rel=1e-9, abs=1e-12) and beyond > 0
+        assert f'robot_radius {radius:.6g}' in str(error)
+        return
+    assert (result.positions - radius >= bounds[:, 0] - 1e-12).all()
+    assert (result.positions + radius <= bounds[:, 1] + 1e-12).all()
 
 
 def test_bounds_are_validated_with_the_expected_and_the_given_shape():

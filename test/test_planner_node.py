@@ -230,12 +230,14 @@ def test_every_error_code_and_the_node_keeps_serving(planner, ros_client, monkey
     box = [-3.5, 4.0, -3.0, 4.0]
     assert all(r.successful for r in node.set_parameters(workspace_bounds=box))
     expect(make_request([c1, moved(c2, 3, [4.25, 1.0, 0.0])]), codes.OUTSIDE_WORKSPACE,
-           'configuration 1: robot 3 is 0.25 beyond the wall x_max = 4 (centre x = 4.25)')
+           'configuration 1: robot 3 is 0.25 beyond the wall x_max (workspace_bounds[1]) = 4 '
+           '(centre x = 4.25)')
     expect(make_request([c1, moved(c2, 3, [4.25, 1.0, 0.0]), moved(c3, 0, OBSTACLES[1])]),
            codes.ROBOT_ON_OBSTACLE, 'configuration 2', 'robot 0')  # it ranks before
     node.set_parameters(obstacles=flat(OBSTACLES[:2] + [[2.5, -3.5, 0.0]]))
     expect(make_request(), codes.OUTSIDE_WORKSPACE,
-           'obstacle 2 at (2.5, -3.5, 0) (from the parameter) is 0.5 beyond the wall y_min = -3')
+           'obstacle 2 at (2.5, -3.5, 0) (from the parameter) is 0.5 beyond the wall y_min '
+           '(workspace_bounds[2]) = -3')
     node.set_parameters(obstacles=flat(OBSTACLES))
     from punctured_planner.core import plan, PlanningError, Workspace
     with pytest.raises(PlanningError) as leaves:  # the construction's lanes leave the box
@@ -245,8 +247,9 @@ def test_every_error_code_and_the_node_keeps_serving(planner, ros_client, monkey
     assert leaves.value.leg is not None and leaves.value.distance > 0
     node.set_parameters(refine=False)
     expect(make_request(), codes.OUTSIDE_WORKSPACE,
-           'the plan takes robot %d %.6g beyond the wall %s' % (
-               leaves.value.robots[0], leaves.value.distance, leaves.value.wall.name),
+           'the plan takes robot %d %.6g beyond the wall %s (workspace_bounds[%d])' % (
+               leaves.value.robots[0], leaves.value.distance, leaves.value.wall.name,
+               leaves.value.wall.index),
            'on leg %d (' % leaves.value.leg)
     node.set_parameters(workspace_bounds=[], refine=True)
     valid()
@@ -471,11 +474,11 @@ def test_a_second_client_context_gets_the_same_latched_plan(planner, ros_client)
 
 
 def test_a_bad_obstacle_set_is_refused_on_arrival(planner, ros_client, monkeypatch):
-    """Issue 15.4: wrong frame or off the plane: warned and refused, the good set stays."""
+    """Wrong frame, off the plane, outside the walls: warned and refused, the good set stays."""
     from punctured_planner.cli import reset_obstacles
     from punctured_planner.ros.qos import LATCHED
     _, pose_array_type, _, _, _, _ = _types()
-    node = planner(obstacles=flat(OBSTACLES))
+    node = planner(obstacles=flat(OBSTACLES), workspace_bounds=[-6.0, 6.0, -6.0, 6.0])
     checked = []
     original = node.node._handler.check_obstacles
 
@@ -486,7 +489,8 @@ def test_a_bad_obstacle_set_is_refused_on_arrival(planner, ros_client, monkeypat
     publisher = ros_client.node.create_publisher(pose_array_type, node.name('obstacles'),
                                                  LATCHED)
     for bad in (pose_array(OBSTACLES, frame_id='odom'),
-                pose_array([[0.0, 0.0, 0.3], [1.0, 0.0, 0.0]])):
+                pose_array([[0.0, 0.0, 0.3], [1.0, 0.0, 0.0]]),
+                pose_array([[0.0, 0.0, 0.0], [6.5, 0.0, 0.0]])):
         count = len(checked)
         publisher.publish(bad)
         assert ros_client.spin_until(lambda: len(checked) > count, 10)

@@ -6,8 +6,8 @@ One module per idea of the paper: ``space`` (the space), ``frame`` (its frame),
 lanes, the composition of Remark 2.3 and the variant table), ``plan`` (the
 plan as breakpoints), ``certificate`` (exact clearance), ``timing`` (time
 parameterisation), ``complexity`` (domains and TC_n), ``pairs`` (index arrays
-of point pairs), ``validation`` and ``errors``. The design, with the proofs,
-is doc/design.md.
+of point pairs), ``walls`` (workspace bounds), ``validation`` and ``errors``.
+The design, with the proofs, is doc/design.md.
 """
 
 from .certificate import Clearance

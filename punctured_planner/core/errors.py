@@ -4,13 +4,14 @@ Planning errors: a machine-readable code plus the culprits as data, Nav2 style.
 A :class:`PlanningError` carries its culprits (configuration, robots,
 obstacle, coordinate, and for OUTSIDE_WORKSPACE the wall, the distance and the
 leg) as numbers and its message as a template in which the
-configuration and obstacles are slots: ``{configuration}``, ``{obstacle}``,
-``{obstacles}``, ``{waypoint}`` and ``{next_waypoint}`` (C_{m+1} and C_{m+2}
-of ``configuration`` m). :meth:`PlanningError.describe` fills the slots with
-a :class:`Names`: the core's own (``configuration 2``, ``obstacle 1 at [0.0,
-1.0]``) for ``str()``, the ROS layer's (the request's configuration labels,
-the obstacles' positions and source) for a service response. Free text put
-into a template goes through :func:`literal`.
+configuration, obstacles and wall are slots: ``{configuration}``,
+``{obstacle}``, ``{obstacles}``, ``{waypoint}`` and ``{next_waypoint}``
+(C_{m+1} and C_{m+2} of ``configuration`` m), ``{wall}``.
+:meth:`PlanningError.describe` fills the slots with a :class:`Names`: the
+core's own (``configuration 2``, ``obstacle 1 at [0.0, 1.0]``, ``the wall
+x_max``) for ``str()``, the ROS layer's (the request's configuration labels,
+the obstacles' positions and source, the wall's parameter entry) for a
+service response. Free text put into a template goes through :func:`literal`.
 """
 
 from collections.abc import Iterable
@@ -75,6 +76,10 @@ class Names:
         """Return the name of several obstacles: 'obstacles 0 and 3'."""
         return 'obstacles ' + ' and '.join(str(j) for j in indices)
 
+    def wall(self, wall: 'Wall') -> str:
+        """Return the name of a wall of the workspace bounds: 'the wall x_max'."""
+        return f'the wall {wall.name}'
+
 
 class _Slots(dict):
     """The slot values of one error's template, each computed when the template asks."""
@@ -95,6 +100,8 @@ class _Slots(dict):
             return names.obstacle(int(error.obstacle), error.point)  # type: ignore[arg-type]
         if slot == 'obstacles':
             return names.obstacles(error.obstacles)
+        if slot == 'wall':
+            return names.wall(error.wall)  # type: ignore[arg-type]
         raise KeyError(slot)
 
 

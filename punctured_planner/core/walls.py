@@ -43,6 +43,11 @@ class Wall:
         """Return the wall's name: 'x_min', 'y_max', ... ('x3_min' beyond z)."""
         return f'{axis_name(self.axis)}_{"max" if self.high else "min"}'
 
+    @property
+    def index(self) -> int:
+        """Return the wall's index in bounds.ravel(): x_min, x_max, y_min, ..."""
+        return 2 * self.axis + int(self.high)
+
     def position(self, bounds: np.ndarray) -> float:
         """Return the wall's coordinate in bounds (d, 2)."""
         return float(bounds[self.axis, int(self.high)])
@@ -71,13 +76,13 @@ class WallSlack:
     def words(self, bounds: np.ndarray, centre: float, radius: float,
               radius_name: str) -> str:
         """
-        Return 'D beyond the wall x_max = 5 (...)', centre being the body's coordinate.
+        Return the template 'D beyond {wall} = 5 (...)', centre the body's coordinate.
 
         The parenthesis gives the centre's coordinate, and the radius it must keep
         from the wall when the body has one.
         """
         keeps = f', which must keep {radius_name} {radius:.6g} from it' if radius > 0 else ''
-        return (f'{self.beyond:.6g} beyond the wall {self.wall.name} = '
+        return (f'{self.beyond:.6g} beyond {{wall}} = '
                 f'{self.wall.position(bounds):.6g} (centre {axis_name(self.wall.axis)} = '
                 f'{centre:.6g}{keeps})')
 

@@ -1,12 +1,13 @@
 """
-How the ROS layer names configurations and obstacles in an error message: once, here.
+How the ROS layer names configurations, obstacles and walls in an error message: here.
 
 A :class:`~punctured_planner.core.errors.PlanningError` carries its culprits
 as numbers and its message as a template (see core/errors.py); the service
 response words it with :class:`RequestNames`: a configuration by its label in
-the request (the current state first, with use_current_state) and an obstacle
-by its index, position and source. The core numbers only the configurations
-it plans; ``planned`` maps them back to the request's.
+the request (the current state first, with use_current_state), an obstacle by
+its index, position and source, and a wall of the workspace bounds by its
+entry in the workspace_bounds parameter. The core numbers only the
+configurations it plans; ``planned`` maps them back to the request's.
 """
 
 from typing import Callable
@@ -14,10 +15,11 @@ from typing import Sequence
 
 from .snapshot import ObstacleSet
 from ..core.errors import Names
+from ..core.walls import Wall
 
 
 class ObstacleNames(Names):
-    """Obstacles by index, position and source (the node's obstacle set)."""
+    """Obstacles by index, position and source (the node's obstacle set); walls by entry."""
 
     def __init__(self, obstacles: ObstacleSet) -> None:
         """Name the obstacles of ``obstacles``."""
@@ -30,6 +32,10 @@ class ObstacleNames(Names):
     def obstacles(self, indices: tuple[int, ...]) -> str:
         """Return the names of several obstacles, joined by 'and'."""
         return ' and '.join(self._obstacles.name(j) for j in indices)
+
+    def wall(self, wall: Wall) -> str:
+        """Return 'the wall x_max (workspace_bounds[1])': the parameter entry that sets it."""
+        return 'the wall %s (workspace_bounds[%d])' % (wall.name, wall.index)
 
 
 class RequestNames(ObstacleNames):
