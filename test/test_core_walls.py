@@ -221,7 +221,9 @@ def test_disc_plans_keep_their_radius_from_every_wall_or_are_refused(case, margi
         result = plan(walled, configurations, refine=refine)
     except PlanningError as error:
         assert error.code == ErrorCode.OUTSIDE_WORKSPACE, str(error)
-        free = plan(workspace, configurations, refine=refine).positions
+        # the motion the refusal judged: the construction's, refined against the walls
+        free = plan(workspace, configurations, refine=False)
+        free = (refined_with_walls(free, bounds) if refine else free).positions
         leg, robot, wall = error.leg, error.robots[0], error.wall
         ends = free[leg:leg + 2, robot, wall.axis]
         beyond = (ends.max() + radius - bounds[wall.axis, 1] if wall.high
