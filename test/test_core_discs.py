@@ -41,10 +41,11 @@ def keeps_margin(p):
 @PROPERTY
 @given(lattice_requests())
 def test_bodies_keep_the_margin_when_the_condition_holds(case):
-    """The theorem: min_gap >= R / 10 on every input that meets the stated condition."""
+    """The theorem: min_gap >= R / 10 on every input that meets it, refined or not."""
     workspace, configurations = case
-    p = plan(workspace, configurations, certify=False, refine=False)
-    assert keeps_margin(p), (p.min_gap, p.gap, p.leg_names[p.gap.leg])
+    for refine in (False, True):
+        p = plan(workspace, configurations, certify=False, refine=refine)
+        assert keeps_margin(p), (refine, p.min_gap, p.gap, p.leg_names[p.gap.leg])
 
 
 @pytest.mark.parametrize('rho_over_radius', [0.5, 1.0, 1.5])

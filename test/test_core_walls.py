@@ -17,6 +17,7 @@ from punctured_planner.core.validation import validate_configurations
 from punctured_planner.core.walls import (checked_bounds, first_outside, smallest_leg_slack,
                                           Wall, wall_slack)
 import pytest
+from test_core_refine import refined_with_walls
 
 PROPERTY = settings(max_examples=150, deadline=None,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
@@ -188,8 +189,10 @@ def test_a_plan_is_inside_its_bounds_or_refused_naming_where_it_leaves(
     except PlanningError as error:
         assert error.code == ErrorCode.OUTSIDE_WORKSPACE, str(error)
         robot, axis, leg = error.robots[0], error.wall.axis, error.leg
-        ends = plan(Workspace(obstacles, dimension=configurations.shape[2], variant=variant),
-                    configurations).positions[leg:leg + 2, robot, axis]
+        # The refined motion the refusal judged: the construction's, refined against the walls.
+        raw = plan(Workspace(obstacles, dimension=configurations.shape[2], variant=variant),
+                   configurations, refine=False)
+        ends = refined_with_walls(raw, bounds).positions[leg:leg + 2, robot, axis]
         high, low = ends.max() - bounds[axis, 1], bounds[axis, 0] - ends.min()
         beyond = high if error.wall.high else low
         assert beyond == pytest.approx(error.distance, rel=1e-12) and beyond > 0
@@ -218,7 +221,9 @@ def test_disc_plans_keep_their_radius_from_every_wall_or_are_refused(case, margi
         result = plan(walled, configurations, refine=refine)
     except PlanningError as error:
         assert error.code == ErrorCode.OUTSIDE_WORKSPACE, str(error)
-        free = plan(workspace, configurations, refine=refine).positions
+        # the motion the refusal judged: the construction's, refined against the walls
+        free = plan(workspace, configurations, refine=False)
+        free = (refined_with_walls(free, bounds) if refine else free).positions
         leg, robot, wall = error.leg, error.robots[0], error.wall
         ends = free[leg:leg + 2, robot, wall.axis]
         beyond = (ends.max() + radius - bounds[wall.axis, 1] if wall.high
@@ -293,5 +298,8 @@ def test_outside_workspace_ranks_beside_robot_on_obstacle_and_clearance_below_re
     with pytest.raises(PlanningError) as error:
         plan(Workspace(obstacles, bounds=tight), inside)
     assert error.value.code == ErrorCode.OUTSIDE_WORKSPACE and error.value.leg is not None
+    # judged on the motion refined against the walls (which comes nearer than raw)
+    judged = refined_with_walls(plan(Workspace(obstacles), inside, refine=False),
+                                tight).positions
     assert error.value.distance == pytest.approx(
-        max((raw.positions - tight[:, 1]).max(), (tight[:, 0] - raw.positions).max()))
+        max((judged - tight[:, 1]).max(), (tight[:, 0] - judged).max()))

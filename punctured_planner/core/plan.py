@@ -323,7 +323,7 @@ def _refined(raw):
     k = raw.positions.shape[1]
     radii = np.concatenate([np.full(k, workspace.robot_radius), workspace.obstacle_radii])
     rounding = RELATIVE_RESOLUTION * float(np.abs(raw.positions).max(initial=1.0))
-    bodies = Bodies(workspace.obstacles, radii, raw.min_gap, rounding)
+    bodies = Bodies(workspace.obstacles, radii, raw.min_gap, rounding, workspace.bounds)
     return Plan.refined(raw, refine_motion(raw.times, raw.positions, raw.waypoint_indices,
                                            bodies))
 

@@ -25,6 +25,12 @@ lemma). Every pair is evaluated, so no pair enters or leaves the checked set;
 every quantity is a continuous function of the input, and the number of
 blocks, sweeps and knots is fixed, so the map stays continuous on every domain
 (doc/design.md section 14).
+
+With walls (Bodies.bounds) each robot's change along each axis is kept within
+half its slack to the wall behind it (0 where it is beyond that wall), and
+where a knot's hat reaches beyond a wall the block starts from a pull
+inwards: the motion never reaches farther beyond a wall than the
+construction's, and a motion inside stays inside (doc/design.md section 14).
 """
 
 from dataclasses import dataclass
@@ -32,6 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .certificate import certify, segment_minimum
+from .walls import wall_slack
 
 # Knots per segment: the field is piecewise linear on the j / KNOTS fractions.
 KNOTS = 64
@@ -70,13 +77,16 @@ class Bodies:
     """
     What the gaps are measured against: pillars (r, d), radii (k + r,), the margin g0.
 
-    rounding is the slack treated as none (the resolution of the coordinates).
+    rounding is the slack treated as none (the resolution of the coordinates);
+    bounds, None or (d, 2) lows and highs of the workspace's walls in the
+    motion's coordinates, which every robot's centre keeps its radius inside.
     """
 
     obstacles: np.ndarray
     radii: np.ndarray
     margin: float
     rounding: float
+    bounds: np.ndarray | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -167,6 +177,18 @@ def _length(vectors):
     return np.sqrt(squared)
 
 
+def _interval_boxes(planes, points):
+    """
+    Return (low, high), each (d, N - 1, k): every robot's bounding box over each knot interval.
+
+    The motion is linear between the union's breakpoints, so the box of a robot's
+    breakpoints from points[i] to points[i + 1] holds all of its interval i.
+    """
+    low = np.minimum(np.minimum.reduceat(planes, points[:-1], axis=1), planes[:, points[1:]])
+    high = np.maximum(np.maximum.reduceat(planes, points[:-1], axis=1), planes[:, points[1:]])
+    return low, high
+
+
 def _interval_minima(planes, knots, pillars=None):
     """
     Return (N - 1, k, m) the exact smallest distance over each knot interval, densely.
@@ -233,12 +255,41 @@ class _Caps:
             slack = (_interval_minima(planes, knots, bodies.obstacles) - offsets).min(axis=2)
             pillar = np.minimum(pillar, PILLAR_SHARE * np.maximum(slack, 0.0))
         self.pair, self.pillar = _knot_caps(pair), _knot_caps(pillar)
+        self.lower = self.upper = self.inward = None
+        if bodies.bounds is not None:
+            self._walls(_interval_boxes(planes, knots.points), bodies, step)
+
+    def _walls(self, boxes, bodies, step):
+        """
+        Add the walls: per axis, how far each knot may move down and up, and its pull inwards.
+
+        The signed distance to a wall is linear along a leg, so each box's
+        faces give the exact smallest wall slack of an interval. A robot may
+        move along each axis by half of its slack from the wall behind it over
+        its hat (0 where it is beyond that wall); inward (N, k, d) is, per axis,
+        how far the hat reaches beyond the low wall minus how far beyond the
+        high one: 0 inside (design, 14).
+        """
+        low, high = boxes
+        keep = bodies.radii[0] + bodies.rounding
+        # (N - 1, k, d): the lowest corner's slack to each wall min, the highest's to each max.
+        slacks = [wall_slack(np.moveaxis(corner, 0, 2), bodies.bounds, keep)[..., side]
+                  for side, corner in enumerate((low, high))]
+        self.lower, self.upper = (
+            _knot_caps(np.minimum(2 * step, PILLAR_SHARE * np.maximum(slack, 0.0)))
+            for slack in slacks)
+        below, above = (_knot_caps(np.maximum(-slack, 0.0), np.maximum) for slack in slacks)
+        self.inward = below - above
 
 
-def _knot_caps(bound):
-    """Return (N, k) caps from interval bounds (N - 1, k): both intervals of each hat."""
-    caps = np.zeros((bound.shape[0] + 1, bound.shape[1]))
-    caps[1:-1] = np.minimum(bound[:-1], bound[1:])
+def _knot_caps(bound, reduce=np.minimum):
+    """
+    Return (N, ...) caps from interval bounds (N - 1, ...): both intervals of each hat.
+
+    reduce np.maximum gives the larger of the two (how far a hat reaches out).
+    """
+    caps = np.zeros((bound.shape[0] + 1,) + bound.shape[1:])
+    caps[1:-1] = reduce(bound[:-1], bound[1:])
     caps[::KNOTS] = 0.0  # the configurations hold
     return caps
 
@@ -272,6 +323,10 @@ class _Block:
         self.common_cap = np.minimum(np.minimum(0.5 * caps.pillar.min(axis=1), step),
                                      _TRANSLATION * caps.pair.min(axis=1))
         self.pair, self.pillar, self.step = caps.pair, caps.pillar, step
+        self.lower, self.upper = caps.lower, caps.upper
+        if self.lower is not None:
+            # The common part stays within every robot's range along each axis.
+            self.common_range = (-self.lower.min(axis=1), self.upper.min(axis=1))
 
     def clip(self, wanted):
         """
@@ -280,9 +335,14 @@ class _Block:
         common is the fleet's mean, clipped; own what each robot still wants, clipped.
         """
         common = _clipped(wanted.mean(axis=1), self.common_cap)
+        if self.lower is not None:
+            # Within every robot's wall limits, so each robot's own part has room around 0.
+            common = np.clip(common, *self.common_range)
         left = self.pillar - _length(common)[:, None]
         own = _clipped(wanted - common[:, None], np.minimum(np.minimum(self.pair, left),
                                                             self.step))
+        if self.lower is not None:
+            own = np.clip(own, -self.lower - common[:, None], self.upper - common[:, None])
         return common, own
 
 
@@ -335,15 +395,18 @@ def refine(times: np.ndarray, positions: np.ndarray, waypoint_indices: np.ndarra
     knots = _Knots.of(union, knot_grid)
     gap = certify(union.times, union.positions, bodies.obstacles,
                   bodies.radii if np.any(bodies.radii > 0) else None).distance
-    bodies = Bodies(bodies.obstacles, bodies.radii, min(bodies.margin, gap), bodies.rounding)
+    bodies = Bodies(bodies.obstacles, bodies.radii, min(bodies.margin, gap), bodies.rounding,
+                    bodies.bounds)
     scale = fleet_scale(configurations, bodies.obstacles)
     base_knots = union.positions[knots.points]
     values = np.zeros((knots.times.size, k, d))
     motion = union.positions
     step = STEP * scale
     for _ in range(block_count(k)):
-        block = _Block(_Caps(motion, knots, bodies, step), step)
-        common, own = np.zeros((values.shape[0], d)), np.zeros_like(values)
+        caps = _Caps(motion, knots, bodies, step)
+        block = _Block(caps, step)
+        common, own = ((np.zeros((values.shape[0], d)), np.zeros_like(values))
+                       if caps.inward is None else block.clip(caps.inward))
         for _ in range(SWEEPS):
             common, own = _sweep(values, common, own, base_knots, block)
         values = values + common[:, None] + own
