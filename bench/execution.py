@@ -271,7 +271,7 @@ PARAMETERS = """
     rate: 20.0
     drive: [%(drive)s]
     yaw_rate_limit: 1.9
-    max_acceleration: 1.0
+    max_acceleration: [1.0]
     max_yaw_acceleration: 8.0
 /**/plan_executor:
   ros__parameters:

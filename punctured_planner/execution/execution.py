@@ -37,6 +37,10 @@ from .tolerance import clock_rate
 
 # Longest step the clock takes at once (s): a stalled control loop does not jump ahead.
 MAX_STEP = 0.2
+# Largest feed-forward gain: a robot that achieves a quarter of its commands is not helped.
+MAX_FEEDFORWARD_GAIN = 4.0
+# Reference speed (m/s) below which a robot's lag says nothing about its feed-forward.
+ADAPT_SPEED = 0.05
 HOLONOMIC = 'holonomic'
 DIFFERENTIAL = 'differential'
 DRIVES = (HOLONOMIC, DIFFERENTIAL)
@@ -55,6 +59,8 @@ class ExecutionSettings:
     drive: tuple = (HOLONOMIC,)         # one value, or one per robot in plan order
     yaw_rate_limit: float = 1.0         # rad/s, differential robots
     final_heading: bool = True          # differential robots end facing their last pose
+    # 1/s: how fast each robot's feed-forward gain learns its lag along its reference; 0: off
+    feedforward_adaptation: float = 0.1
 
     def differential(self, robot_count: int) -> np.ndarray:
         """Return the (k,) mask of differential robots; ValueError if drive does not fit k."""
@@ -85,7 +91,7 @@ class Step:
     yaw_rates: np.ndarray       # (k,) differential robots' yaw rates (rad/s), else 0
 
 
-def saturate(velocities: np.ndarray, limit: float) -> np.ndarray:
+def saturate(velocities: np.ndarray, limit: float | np.ndarray) -> np.ndarray:
     """Return (k, 3) velocities scaled down to speed at most limit, direction kept."""
     speeds = np.linalg.norm(velocities, axis=-1, keepdims=True)
     scale = np.minimum(1.0, limit / np.maximum(speeds, np.finfo(float).tiny))
@@ -115,6 +121,9 @@ class Execution:
         # robots driving backward: their lead point is e behind, their 'heading' theta + pi
         self.reverse = np.zeros(reference.robot_count, dtype=bool)
         self.settled = 0.0     # seconds every final heading has been reached for
+        # (k,) what each robot's feed-forward is multiplied by: 1 until it lags (_feedforward)
+        self.feedforward_gains = np.ones(reference.robot_count)
+        self.rate = 0.0        # the clock's last rate
 
     def step(self, dt: float, positions: np.ndarray, stale: np.ndarray,
              orientations: np.ndarray | None = None) -> Step:
@@ -153,16 +162,20 @@ class Execution:
         elif stale.any():
             rate = 0.0
         else:
-            rate = min(clock_rate(watched, self.tolerance, s.slow_fraction, s.hold_fraction),
-                       self._differential_cap(alpha, dt))
+            rate = self._ramp_rate(
+                min(clock_rate(watched, self.tolerance, s.slow_fraction, s.hold_fraction),
+                    self._differential_cap(alpha, dt)), dt)
+        self.rate = rate
         duration = self.reference.duration
         self.plan_time = min(duration, self.plan_time + rate * dt)
         target = self.reference.position(self.plan_time)
-        command = rate * self.reference.velocity(self.plan_time) + s.gain * (target - positions)
+        feedforward = self._feedforward(rate, dt, reference_now - positions, stale)
+        command = feedforward + s.gain * (target - positions)
         velocities = saturate(command, s.speed_limit)
         forward, yaw_rates = np.zeros(k), np.zeros(k)
         if unicycles:
-            unicycle_command = self._unicycle(rate, target, positions, angles, driving, alpha)
+            unicycle_command = self._unicycle(feedforward, target, positions, angles, driving,
+                                              alpha)
             forward = np.where(differential, unicycle_command.forward, 0.0)
             yaw_rates = np.where(differential, unicycle_command.yaw_rate, 0.0)
             velocities = np.where(differential[:, None],
@@ -173,6 +186,51 @@ class Execution:
         finished = self._settled(arrived, angles, dt) and arrived
         return Step(self.plan_time, rate, target, self.reference.orientation(self.plan_time),
                     velocities, errors, finished, self.differential.copy(), forward, yaw_rates)
+
+    def _ramp_rate(self, wanted: float, dt: float) -> float:
+        """
+        Return the clock rate moved toward wanted within the plan's acceleration limit.
+
+        Under the plan's acceleration limit a, the clock changes no faster than
+        lets the fastest reference's velocity rate x r'(s) change by a dt: a
+        rate that jumps is a reference velocity that jumps, which an
+        acceleration-limited robot overshoots by v^2 / (2 a). A plan without
+        the limit keeps the clock's rate as it is.
+        """
+        profile = self.reference.profile
+        if profile is None:
+            return wanted
+        speed = float(np.linalg.norm(self.reference.velocity(self.plan_time), axis=1).max())
+        step = profile.max_acceleration * dt / max(speed, ADAPT_SPEED)
+        return float(np.clip(wanted, self.rate - step, self.rate + step))
+
+    def _feedforward(self, rate: float, dt: float, lags: np.ndarray,
+                     stale: np.ndarray) -> np.ndarray:
+        """
+        Return the (k, 3) feed-forward velocities at the clock's new plan time.
+
+        The reference's velocity plus its acceleration over one control step
+        (an acceleration-limited base answers a command about a step late),
+        times the clock rate, times each robot's feed-forward gain. A gain
+        grows while its robot lags behind a moving reference (lags (k, 3) are
+        reference - position when measured) and shrinks back toward 1 while it
+        is ahead: a robot that achieves only a fraction f of its commands gets
+        about 1 / f of the feed-forward and keeps the pace the clock sets
+        instead of the much lower K e of its feedback alone. With the clock
+        held (rate 0) there is no feed-forward, so the hold's argument
+        (doc/design.md section 13) is unchanged.
+        """
+        s_now = self.plan_time
+        velocity = self.reference.velocity(s_now)
+        feedforward = rate * velocity + rate * rate * dt * self.reference.acceleration(s_now)
+        speeds = np.linalg.norm(velocity, axis=1)
+        moving = (rate * speeds > ADAPT_SPEED) & ~stale
+        along = np.einsum('kd,kd->k', lags, velocity) / np.maximum(speeds, ADAPT_SPEED)
+        change = self.settings.feedforward_adaptation * dt * along / self.tolerance
+        self.feedforward_gains = np.clip(
+            np.where(moving, self.feedforward_gains + change, self.feedforward_gains),
+            1.0, MAX_FEEDFORWARD_GAIN)
+        return self.feedforward_gains[:, None] * feedforward
 
     def _settled(self, arrived: bool, angles: np.ndarray, dt: float) -> bool:
         """Return whether every differential robot has faced its final heading for SETTLE s."""
@@ -233,13 +291,14 @@ class Execution:
         caps = np.minimum(caps, self.corners.corner_caps(s_now, self.steering, limit))
         return float(np.min(caps[self.differential], initial=1.0))
 
-    def _unicycle(self, rate: float, target: np.ndarray, positions: np.ndarray,
+    def _unicycle(self, feedforward: np.ndarray, target: np.ndarray, positions: np.ndarray,
                   angles: np.ndarray, driving: np.ndarray,
                   alpha: np.ndarray) -> unicycle.UnicycleCommand:
         """
         Return every robot's unicycle command: follow, turn, park or face the final pose.
 
-        angles are the yaws, driving the driving headings (yaw + pi backward).
+        feedforward (k, 3) is :meth:`_feedforward`'s, angles are the yaws,
+        driving the driving headings (yaw + pi backward), alpha the misalignments.
         """
         s = self.settings
         if self.plan_time >= self.reference.duration:
@@ -251,8 +310,7 @@ class Execution:
             return unicycle.UnicycleCommand(np.where(parked, 0.0, command.forward),
                                             np.where(parked, final, command.yaw_rate))
         lead_points = unicycle.lead_points(positions, driving, self.lead)
-        desired = rate * self.reference.velocity(self.plan_time) + s.gain * (target
-                                                                             - lead_points)
+        desired = feedforward + s.gain * (target - lead_points)
         command = unicycle.follow(desired, driving, self.steering, s.speed_limit,
                                   s.yaw_rate_limit)
         forward = np.where(self.reverse, -command.forward, command.forward)
