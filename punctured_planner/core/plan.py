@@ -25,8 +25,8 @@ from .refine import block_count, Bodies, refine as refine_motion, Refinement
 from .sections import compose, lane_heights, SCHEDULES, segment_times
 from .space import Workspace
 from .strata import epsilon, projection_count, projection_gaps
-from .timing import (breakpoint_stamps, corner_jump, length_times, resample, speed_profile,
-                     SpeedProfile)
+from .timing import (corner_jump, length_times, resample, speed_profile, SpeedProfile,
+                     stamps as timed_stamps)
 from .validation import validate_configurations
 
 
@@ -249,9 +249,9 @@ class Plan:
         max_acceleration 0 (unlimited): each leg at max_speed throughout; else the
         profile's stamps, at rest at both ends and slowed into the corners.
         """
-        if max_acceleration == 0:
-            return breakpoint_stamps(self.positions, max_speed)
-        return self.profile(max_speed, max_acceleration).stamps()
+        # the gap only matters to the corners of a limited profile: no certificate for 0
+        return timed_stamps(self.positions, max_speed, max_acceleration,
+                            self.min_gap if max_acceleration else 0.0)
 
     def duration(self, max_speed: float, max_acceleration: float = 0.0) -> float:
         """Return the duration in seconds of the whole motion under both limits."""

@@ -181,6 +181,21 @@ def speed_profile(positions: np.ndarray, max_speed: float, max_acceleration: flo
     return SpeedProfile(lengths, speeds, float(max_speed), float(max_acceleration))
 
 
+def stamps(positions: np.ndarray, max_speed: float, max_acceleration: float,
+           min_gap: float) -> np.ndarray:
+    """
+    Return (V,) seconds at each breakpoint of positions (V, k, d): the timing law.
+
+    max_acceleration 0 (unlimited): each leg at max_speed throughout
+    (:func:`breakpoint_stamps`); else the fastest SpeedProfile, its corners'
+    jumps from min_gap (:func:`corner_jump`).
+    """
+    if max_acceleration == 0:
+        return breakpoint_stamps(positions, max_speed)
+    return speed_profile(positions, max_speed, max_acceleration,
+                         corner_jump(max_acceleration, min_gap)).stamps()
+
+
 def resample(values: npt.ArrayLike, positions: np.ndarray, samples_per_leg: int,
              profile: SpeedProfile | None = None
              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -230,6 +230,12 @@ class ExecutorSettings:
         "'request': after the plan's end every differential robot turns in place to the "
         "orientation of its last pose (the request's; identity faces +x); 'none': it "
         'stops facing where it arrived.', choices=('request', 'none')).field()
+    feedforward_adaptation: float = Spec(
+        'feedforward_adaptation', 'double', 0.1,
+        "How fast (1/s) each robot's feed-forward gain grows while it lags behind its "
+        'moving reference (and falls back toward 1 while it is ahead), up to 4: a robot '
+        'that achieves a fraction f of its commands gets about 1/f of the feed-forward; 0: '
+        'off.', low=0.0, high=100.0).field()
 
     @property
     def execution(self) -> ExecutionSettings:
@@ -240,7 +246,8 @@ class ExecutorSettings:
                                  goal_tolerance=self.goal_tolerance,
                                  shared_clock=self.shared_clock == 'on', drive=self.drive,
                                  yaw_rate_limit=self.yaw_rate_limit,
-                                 final_heading=self.final_heading == 'request')
+                                 final_heading=self.final_heading == 'request',
+                                 feedforward_adaptation=self.feedforward_adaptation)
 
 
 def _slow_below_hold(settings: ExecutorSettings) -> None:
