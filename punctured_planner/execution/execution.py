@@ -162,7 +162,7 @@ class Execution:
         elif stale.any():
             rate = 0.0
         else:
-            rate = self._ramp_rate(
+            rate = self._rate_rise(
                 min(clock_rate(watched, self.tolerance, s.slow_fraction, s.hold_fraction),
                     self._differential_cap(alpha, dt)), dt)
         self.rate = rate
@@ -187,22 +187,21 @@ class Execution:
         return Step(self.plan_time, rate, target, self.reference.orientation(self.plan_time),
                     velocities, errors, finished, self.differential.copy(), forward, yaw_rates)
 
-    def _ramp_rate(self, wanted: float, dt: float) -> float:
+    def _rate_rise(self, wanted: float, dt: float) -> float:
         """
-        Return the clock rate moved toward wanted within the plan's acceleration limit.
+        Return wanted, or less where the clock would speed up faster than the plan allows.
 
-        Under the plan's acceleration limit a, the clock changes no faster than
-        lets the fastest reference's velocity rate x r'(s) change by a dt: a
-        rate that jumps is a reference velocity that jumps, which an
-        acceleration-limited robot overshoots by v^2 / (2 a). A plan without
-        the limit keeps the clock's rate as it is.
+        Under the plan's acceleration limit a, the clock rises no faster than
+        lets the fastest reference's velocity rate x r'(s) grow by a dt: released
+        from a hold at once, every robot limited to a would lag its reference's
+        jump by up to v^2 / (2 a) and hold the clock again. It still slows and
+        holds at once. A plan without the limit keeps the clock's rate as it is.
         """
         profile = self.reference.profile
         if profile is None:
             return wanted
         speed = float(np.linalg.norm(self.reference.velocity(self.plan_time), axis=1).max())
-        step = profile.max_acceleration * dt / max(speed, ADAPT_SPEED)
-        return float(np.clip(wanted, self.rate - step, self.rate + step))
+        return min(wanted, self.rate + profile.max_acceleration * dt / max(speed, ADAPT_SPEED))
 
     def _feedforward(self, rate: float, dt: float, lags: np.ndarray,
                      stale: np.ndarray) -> np.ndarray:
