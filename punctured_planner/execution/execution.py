@@ -60,7 +60,7 @@ class ExecutionSettings:
     yaw_rate_limit: float = 1.0         # rad/s, differential robots
     final_heading: bool = True          # differential robots end facing their last pose
     # 1/s: how fast each robot's feed-forward gain learns its lag along its reference; 0: off
-    feedforward_adaptation: float = 0.1
+    feedforward_adaptation: float = 0.3
 
     def differential(self, robot_count: int) -> np.ndarray:
         """Return the (k,) mask of differential robots; ValueError if drive does not fit k."""
@@ -211,9 +211,12 @@ class Execution:
         The reference's velocity plus its acceleration over one control step
         (an acceleration-limited base answers a command about a step late),
         times the clock rate, times each robot's feed-forward gain. A gain
-        grows while its robot lags behind a moving reference (lags (k, 3) are
-        reference - position when measured) and shrinks back toward 1 while it
-        is ahead: a robot that achieves only a fraction f of its commands gets
+        grows while its robot lags behind a moving reference by more than
+        slow_fraction delta, so far that the clock waits for it (lags (k, 3)
+        are reference - position when measured; a lag below that, from latency,
+        odometry age or a corner, is left to the feedback), and shrinks back
+        toward 1 while it is ahead: a robot that achieves only a fraction f of
+        its commands gets
         about 1 / f of the feed-forward and keeps the pace the clock sets
         instead of the much lower K e of its feedback alone. With the clock
         held (rate 0) there is no feed-forward, so the hold's argument
@@ -225,7 +228,9 @@ class Execution:
         speeds = np.linalg.norm(velocity, axis=1)
         moving = (rate * speeds > ADAPT_SPEED) & ~stale
         along = np.einsum('kd,kd->k', lags, velocity) / np.maximum(speeds, ADAPT_SPEED)
-        change = self.settings.feedforward_adaptation * dt * along / self.tolerance
+        waited = self.settings.slow_fraction * self.tolerance
+        excess = np.where(along > waited, along - waited, np.minimum(along, 0.0))
+        change = self.settings.feedforward_adaptation * dt * excess / self.tolerance
         self.feedforward_gains = np.clip(
             np.where(moving, self.feedforward_gains + change, self.feedforward_gains),
             1.0, MAX_FEEDFORWARD_GAIN)

@@ -231,11 +231,11 @@ class ExecutorSettings:
         "orientation of its last pose (the request's; identity faces +x); 'none': it "
         'stops facing where it arrived.', choices=('request', 'none')).field()
     feedforward_adaptation: float = Spec(
-        'feedforward_adaptation', 'double', 0.1,
+        'feedforward_adaptation', 'double', 0.3,
         "How fast (1/s) each robot's feed-forward gain grows while it lags behind its "
-        'moving reference (and falls back toward 1 while it is ahead), up to 4: a robot '
-        'that achieves a fraction f of its commands gets about 1/f of the feed-forward; 0: '
-        'off.', low=0.0, high=100.0).field()
+        'moving reference by more than slow_fraction of the tolerance (and falls back '
+        'toward 1 while it is ahead), up to 4: a robot that achieves a fraction f of its '
+        'commands gets about 1/f of the feed-forward; 0: off.', low=0.0, high=100.0).field()
 
     @property
     def execution(self) -> ExecutionSettings:
