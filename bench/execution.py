@@ -309,6 +309,7 @@ def dds_run(the_plan, slow, late, shared_clock, tag, drive='holonomic'):
                    'executed': result.executed_duration.sec
                    + result.executed_duration.nanosec * 1e-9, 'wall': wall,
                    'error': max(result.max_tracking_errors), 'gap': graph.gap[-1],
+                   'worst': int(np.argmax(result.max_tracking_errors)),
                    'running': max(running[-1].max_tracking_errors) if running else 0.0,
                    'final': final, 'feedback': len(feedback),
                    'heading': max((h + np.pi) % (2 * np.pi) - np.pi for h in headings),
@@ -458,12 +459,13 @@ def differential_line(differential, holonomic, tolerance):
         'Differential drive, same plan and faults, shared clock (1.9 rad/s, 1 m/s^2, '
         '8 rad/s^2): result %d, true smallest gap %.3f m, %d contacts, largest tracking '
         'error while the clock ran %.3f m = %.2f of the tolerance (%.3f m = %.2f over the '
-        'whole run, stops after the end included; holonomic %.3f m and %.3f m), farthest '
+        'whole run, by robot_%d, stops after the end included; holonomic %.3f m and %.3f m, '
+        'by robot_%d), farthest '
         'from its goal %.4f m, largest final heading error %.4f rad, executed %.1f s = %.2f '
         'x the holonomic run (%.1f s); %d cmd_vel messages, %d with a non-zero linear.y.' % (
             f['code'], f['gap'], f['processes']['fleet_sim'][2], f['running'],
-            f['running'] / tolerance, f['error'], f['error'] / tolerance,
-            holonomic['running'], holonomic['error'], f['final'], f['heading'], f['executed'],
+            f['running'] / tolerance, f['error'], f['error'] / tolerance, f['worst'],
+            holonomic['running'], holonomic['error'], holonomic['worst'], f['final'], f['heading'], f['executed'],
             f['executed'] / holonomic['executed'], holonomic['executed'], f['commands'],
             f['sideways']))
 
