@@ -460,14 +460,14 @@ def differential_line(differential, holonomic, tolerance):
         '8 rad/s^2): result %d, true smallest gap %.3f m, %d contacts, largest tracking '
         'error while the clock ran %.3f m = %.2f of the tolerance (%.3f m = %.2f over the '
         'whole run, by robot_%d, stops after the end included; holonomic %.3f m and %.3f m, '
-        'by robot_%d), farthest '
-        'from its goal %.4f m, largest final heading error %.4f rad, executed %.1f s = %.2f '
-        'x the holonomic run (%.1f s); %d cmd_vel messages, %d with a non-zero linear.y.' % (
+        'by robot_%d), farthest from its goal %.4f m, largest final heading error %.4f rad, '
+        'executed %.1f s = %.2f x the holonomic run (%.1f s); %d cmd_vel messages, %d with '
+        'a non-zero linear.y.' % (
             f['code'], f['gap'], f['processes']['fleet_sim'][2], f['running'],
             f['running'] / tolerance, f['error'], f['error'] / tolerance, f['worst'],
-            holonomic['running'], holonomic['error'], holonomic['worst'], f['final'], f['heading'], f['executed'],
-            f['executed'] / holonomic['executed'], holonomic['executed'], f['commands'],
-            f['sideways']))
+            holonomic['running'], holonomic['error'], holonomic['worst'], f['final'],
+            f['heading'], f['executed'], f['executed'] / holonomic['executed'],
+            holonomic['executed'], f['commands'], f['sideways']))
 
 
 def main(argv=None):
