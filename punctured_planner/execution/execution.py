@@ -7,11 +7,13 @@ Each step (doc/design.md section 13; msg_docs/ExecutePlan.md):
    current plan time s;
 2. choose the clock rate: 0 while any robot's odometry is stale, else
    :func:`clock_rate` of the errors and the tracking tolerance (with
-   ``shared_clock`` off, 1: every robot follows the stamps on its own);
+   ``shared_clock`` off, 1: every robot follows the stamps on its own),
+   rising no faster than the plan's acceleration limit allows;
 3. advance s by rate x dt (at most the plan's duration);
 4. command each robot feed-forward plus feedback, saturated at its speed
-   limit: v = sat(rate x reference'(s) + gain x (reference(s) - position)).
-   A stale robot gets 0.
+   limit: v = sat(g (rate x reference'(s) + rate^2 dt x reference''(s))
+   + gain x (reference(s) - position)), g the robot's learned feed-forward
+   gain. A stale robot gets 0.
 
 Differential robots (``drive``) track through :mod:`.unicycle` instead: the
 clock sees the bound E = |reference - P| + e of each one's centre error, is
@@ -39,7 +41,8 @@ from .tolerance import clock_rate
 MAX_STEP = 0.2
 # Largest feed-forward gain: a robot that achieves a quarter of its commands is not helped.
 MAX_FEEDFORWARD_GAIN = 4.0
-# Reference speed (m/s) below which a robot's lag says nothing about its feed-forward.
+# Reference speed (m/s) below which a robot's lag says nothing about its feed-forward
+# (and the clock's rise counts the reference as moving this fast).
 ADAPT_SPEED = 0.05
 HOLONOMIC = 'holonomic'
 DIFFERENTIAL = 'differential'
@@ -216,11 +219,10 @@ class Execution:
         are reference - position when measured; a lag below that, from latency,
         odometry age or a corner, is left to the feedback), and shrinks back
         toward 1 while it is ahead: a robot that achieves only a fraction f of
-        its commands gets
-        about 1 / f of the feed-forward and keeps the pace the clock sets
-        instead of the much lower K e of its feedback alone. With the clock
-        held (rate 0) there is no feed-forward, so the hold's argument
-        (doc/design.md section 13) is unchanged.
+        its commands gets about 1 / f of the feed-forward and keeps the pace
+        the clock sets instead of the much lower K e of its feedback alone.
+        With the clock held (rate 0) there is no feed-forward, so the hold's
+        argument (doc/design.md section 13) is unchanged.
         """
         s_now = self.plan_time
         velocity = self.reference.velocity(s_now)
