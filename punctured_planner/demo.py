@@ -172,6 +172,8 @@ def _print_ratios(recorder, executed, fleet):
     from .core.timing import stamps
     from .ros import conversions
     from .ros.settings import FleetSimSettings
+    # the latched plan may reach this late-joined subscriber after the goal's result
+    recorder.spin(lambda: any(t == '/demo/plan' for t, _, _ in recorder.messages), 10)
     plan = next(m for t, m, _ in recorder.messages if t == '/demo/plan')
     reference = conversions.plan_reference(plan)
     factors = np.asarray(fleet.get('speed_factors') or [1.0] * reference.robot_count)
