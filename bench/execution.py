@@ -36,6 +36,7 @@ RESULTS_MD = os.path.join(HERE, 'execution.md')
 K = 20
 RADIUS = 0.1
 SPEED = 0.5          # the robots' speed limit and the plan's max_speed (m/s)
+ACCELERATION = 1.0   # the robots' acceleration limit and the plan's max_acceleration (m/s^2)
 LATENCY = 0.2
 NOISE = 0.05
 OBSTACLES = np.array([[-3.0, 0.4], [0.2, -0.3], [3.1, 0.2]])
@@ -81,14 +82,15 @@ def simulate(the_plan, slow, late, shared_clock):
     from punctured_planner.sim import Fleet
     from punctured_planner.sim import FleetSettings
     positions = xyz(the_plan.positions)
-    reference = Reference(the_plan.stamps(SPEED), positions,
-                          np.tile([0.0, 0.0, 0.0, 1.0], positions.shape[:2] + (1,)))
+    reference = Reference.timed(the_plan.stamps(SPEED, ACCELERATION), positions,
+                                np.tile([0.0, 0.0, 0.0, 1.0], positions.shape[:2] + (1,)),
+                                SPEED, ACCELERATION, the_plan.min_gap)
     bodies = Bodies(RADIUS, xyz(OBSTACLES), np.zeros(len(OBSTACLES)))
     tolerance = tracking_tolerance(the_plan.min_gap)
     fleet = Fleet(positions[0], FleetSettings(
         bodies=bodies, speed_limit=SPEED, speed_factors=np.where(np.arange(K) == slow, 0.5, 1),
         latencies=np.where(np.arange(K) == late, LATENCY, 0.0), velocity_noise=NOISE,
-        seed=slow))
+        seed=slow, max_acceleration=ACCELERATION))
     execution = Execution(reference, tolerance, ExecutionSettings(
         speed_limit=SPEED, shared_clock=shared_clock), bodies)
     now, contacts = 0.0, 0
@@ -141,7 +143,8 @@ class Graph:
             'factors': np.where(np.arange(K) == slow, 0.5, 1.0).tolist(),
             'latencies': np.where(np.arange(K) == late, LATENCY, 0.0).tolist(),
             'obstacles': xyz(OBSTACLES).ravel().tolist(),
-            'clock': 'on' if shared_clock else 'off', 'drive': drive})
+            'clock': 'on' if shared_clock else 'off', 'drive': drive,
+            'acceleration': ACCELERATION})
         params.close()
         self.logs = {}
         self.processes = {}
@@ -186,11 +189,12 @@ class Graph:
         from punctured_planner.ros.snapshot import Outcome
         n = len(the_plan.configurations)
         start_ns = self.node.get_clock().now().nanoseconds
-        paths = conversions.plan_to_paths(the_plan.sample(0, SPEED),
+        paths = conversions.plan_to_paths(the_plan.sample(0, SPEED, ACCELERATION),
                                           np.tile([0.0, 0.0, 0.0, 1.0], (n, K, 1)), 'map',
                                           start_ns)
         outcome = Outcome(response=None, plan=the_plan, paths=paths, names=self.names,
-                          start_ns=start_ns, max_speed=SPEED, plan_id=plan_id)
+                          start_ns=start_ns, max_speed=SPEED, max_acceleration=ACCELERATION,
+                          plan_id=plan_id)
         self.plan_publisher.publish(conversions.plan_message(outcome, PlannerSettings()))
 
     def execute(self, plan_id, during=None):
@@ -271,7 +275,7 @@ PARAMETERS = """
     rate: 20.0
     drive: [%(drive)s]
     yaw_rate_limit: 1.9
-    max_acceleration: 1.0
+    max_acceleration: [%(acceleration)s]
     max_yaw_acceleration: 8.0
 /**/plan_executor:
   ros__parameters:
@@ -305,6 +309,7 @@ def dds_run(the_plan, slow, late, shared_clock, tag, drive='holonomic'):
                    'executed': result.executed_duration.sec
                    + result.executed_duration.nanosec * 1e-9, 'wall': wall,
                    'error': max(result.max_tracking_errors), 'gap': graph.gap[-1],
+                   'worst': int(np.argmax(result.max_tracking_errors)),
                    'running': max(running[-1].max_tracking_errors) if running else 0.0,
                    'final': final, 'feedback': len(feedback),
                    'heading': max((h + np.pi) % (2 * np.pi) - np.pi for h in headings),
@@ -369,23 +374,30 @@ def stale_and_cancel(the_plan, slow, late):
 def report(the_plan, rows, slow, late, shared, unshared, cancel, differential):
     """Return the Markdown of bench/execution.md."""
     from punctured_planner.execution import tracking_tolerance
-    nominal = the_plan.duration(SPEED)
-    at_slow = the_plan.duration(SPEED * 0.5)
+    nominal = the_plan.duration(SPEED, ACCELERATION)
+    at_slow = the_plan.duration(SPEED * 0.5, ACCELERATION)
     tolerance = tracking_tolerance(the_plan.min_gap)
+    bound = straight_bound(the_plan, slow)
     lines = [
         '# From plan to motion: execution figures',
         '',
         'Produced by `make bench` (`.venv/bin/python bench/execution.py`). %d disc robots '
         '(R = %.2f m) in a 12 m x 14 m hall with 3 pillars, one configuration above them to '
-        'one below, spread variant: plan duration %.1f s at %.1f m/s (%.1f s at the slow '
-        "robot's speed), min_gap %.3f m, tracking tolerance %.3f m. Speed limit %.1f m/s, "
-        'one robot at speed factor 0.5, the next with %d ms command latency, %d%% velocity '
-        'noise.' % (K, RADIUS, nominal, SPEED, at_slow, the_plan.min_gap, tolerance, SPEED,
-                    LATENCY * 1000, NOISE * 100),
+        'one below, spread variant: plan duration %.1f s at %.1f m/s and %.1f m/s^2 (%.1f s '
+        "at the slow robot's speed; %.1f s without the acceleration limit), min_gap %.3f m, "
+        'tracking tolerance %.3f m. Speed limit %.1f m/s and acceleration limit %.1f m/s^2 '
+        'for every robot, one robot at speed factor 0.5, the next with %d ms command '
+        'latency, %d%% velocity noise.' % (
+            K, RADIUS, nominal, SPEED, ACCELERATION, at_slow, the_plan.duration(SPEED),
+            the_plan.min_gap, tolerance, SPEED, ACCELERATION, LATENCY * 1000, NOISE * 100),
         '',
         '## Over DDS (fleet_sim and plan_executor processes, ExecutePlan action)',
         '',
-        'Slow robot robot_%d, late robot robot_%d.' % (slow, late),
+        'Slow robot robot_%d, late robot robot_%d. Shared clock: executed %.1f s = %.2fx '
+        "the slow robot's straight-line bound (%.1f s at %.2f m/s), %.2fx the plan at its "
+        'speed (%.1f s), %.2fx the plan (%.1f s).' % (
+            slow, late, shared['executed'], shared['executed'] / bound, bound, SPEED * 0.5,
+            shared['executed'] / at_slow, at_slow, shared['executed'] / nominal, nominal),
         '',
         '| run | result | true smallest gap | contacts | executed / plan at slow speed | '
         'largest error / tolerance | farthest from last configuration | exits |',
@@ -434,6 +446,12 @@ def report(the_plan, rows, slow, late, shared, unshared, cancel, differential):
     return '\n'.join(lines)
 
 
+def straight_bound(the_plan, slow):
+    """Return the slow robot's straight-line time from its start to its goal at its speed."""
+    start, goal = the_plan.configurations[0][slow], the_plan.configurations[-1][slow]
+    return float(np.linalg.norm(goal - start)) / (SPEED * 0.5)
+
+
 def differential_line(differential, holonomic, tolerance):
     """Return the sentence on the differential robots' run against the holonomic one."""
     f = differential
@@ -441,14 +459,15 @@ def differential_line(differential, holonomic, tolerance):
         'Differential drive, same plan and faults, shared clock (1.9 rad/s, 1 m/s^2, '
         '8 rad/s^2): result %d, true smallest gap %.3f m, %d contacts, largest tracking '
         'error while the clock ran %.3f m = %.2f of the tolerance (%.3f m = %.2f over the '
-        'whole run, stops after the end included; holonomic %.3f m and %.3f m), farthest '
-        'from its goal %.4f m, largest final heading error %.4f rad, executed %.1f s = %.2f '
-        'x the holonomic run (%.1f s); %d cmd_vel messages, %d with a non-zero linear.y.' % (
+        'whole run, by robot_%d, stops after the end included; holonomic %.3f m and %.3f m, '
+        'by robot_%d), farthest from its goal %.4f m, largest final heading error %.4f rad, '
+        'executed %.1f s = %.2f x the holonomic run (%.1f s); %d cmd_vel messages, %d with '
+        'a non-zero linear.y.' % (
             f['code'], f['gap'], f['processes']['fleet_sim'][2], f['running'],
-            f['running'] / tolerance, f['error'], f['error'] / tolerance,
-            holonomic['running'], holonomic['error'], f['final'], f['heading'], f['executed'],
-            f['executed'] / holonomic['executed'], holonomic['executed'], f['commands'],
-            f['sideways']))
+            f['running'] / tolerance, f['error'], f['error'] / tolerance, f['worst'],
+            holonomic['running'], holonomic['error'], holonomic['worst'], f['final'],
+            f['heading'], f['executed'], f['executed'] / holonomic['executed'],
+            holonomic['executed'], f['commands'], f['sideways']))
 
 
 def main(argv=None):

@@ -9,7 +9,9 @@
    (``use_current_state``);
 3. executes the plan through the ExecutePlan action;
 4. prints the executed duration, the simulator's true smallest gap, how far
-   each robot ended from its goal and from its requested heading;
+   each robot ended from its goal and from its requested heading, and the
+   executed duration against the slowest robot's straight-line bound and
+   against the plan retimed at that robot's speed;
 5. writes ``demo.mcap`` (the plan, every reference pose, cmd_vel and odometry
    message, at their arrival times) and ``demo.gif`` (the executed motion, top
    view), and reads the MCAP back to count cmd_vel messages with a non-zero linear.y.
@@ -94,8 +96,12 @@ class Recorder:
         rclpy.try_shutdown()
 
 
-def _run(recorder, request_path, mcap_path, gif_path):
-    """Plan and execute; write the recording and the GIF; return the exit code."""
+def _run(recorder, request_path, mcap_path, gif_path, fleet):
+    """
+    Plan and execute; write the recording and the GIF; return the exit code.
+
+    fleet is fleet_sim's parameter section (speed limit and factors).
+    """
     from punctured_planner_interfaces.action import ExecutePlan
     from punctured_planner_interfaces.srv import PlanSequence
     from rclpy.action import ActionClient
@@ -146,6 +152,7 @@ def _run(recorder, request_path, mcap_path, gif_path):
               result.error_msg or result.error_code, executed, planned, gap,
               max(result.max_tracking_errors, default=0.0), response.tracking_tolerance))
     _print_arrival(recorder, response)
+    _print_ratios(recorder, executed, fleet)
     _write(recorder, response, mcap_path, gif_path)
     _check_commands(mcap_path)
     return 0 if result.error_code == 0 else 1
@@ -162,6 +169,35 @@ def _print_arrival(recorder, response):
         heading = float(wrap(yaws(orientation[None]) - yaws(wanted[-1:]))[0])
         print('%s: %.4f m from its goal, heading %+.4f rad from the requested one'
               % (name, np.linalg.norm(position - goal[-1]), heading))
+
+
+def _print_ratios(recorder, executed, fleet):
+    """
+    Print the executed duration over the slowest robot's two lower bounds.
+
+    Its straight line at its speed (speed_limit x its speed factor), and the
+    published plan retimed at that speed under the plan's acceleration limit.
+    """
+    from .core.timing import stamps
+    from .ros import conversions
+    from .ros.settings import FleetSimSettings
+    # the latched plan may reach this late-joined subscriber after the goal's result
+    recorder.spin(lambda: any(t == '/demo/plan' for t, _, _ in recorder.messages), 10)
+    plan = next(m for t, m, _ in recorder.messages if t == '/demo/plan')
+    reference = conversions.plan_reference(plan)
+    factors = np.asarray(fleet.get('speed_factors') or [1.0] * reference.robot_count)
+    slowest = int(np.argmin(factors))
+    speed = float(fleet.get('speed_limit', FleetSimSettings.speed_limit)) * factors[slowest]
+    straight = np.linalg.norm(reference.positions[-1] - reference.positions[0], axis=1)
+    bound = float(straight[slowest]) / speed
+    retimed = float(stamps(reference.positions, plan.max_speed * factors[slowest],
+                           plan.max_acceleration, plan.min_gap)[-1])
+    print('slowest robot %s (%.2f m/s): executed %.2f s = %.2fx its straight-line bound '
+          '%.2f s, %.2fx the plan at its speed %.2f s (plan %.2f s at %.2f m/s, %.2f m/s^2: '
+          'executed / plan %.2f)' % (
+              plan.robot_names[slowest], speed, executed, executed / bound, bound,
+              executed / retimed, retimed, reference.duration, plan.max_speed,
+              plan.max_acceleration, executed / reference.duration))
 
 
 def _check_commands(mcap_path):
@@ -236,7 +272,9 @@ def main(argv=None):
     args = parser.parse_args(argv)
     os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
     with open(args.params, encoding='utf-8') as stream:
-        names = yaml.safe_load(stream)['/**']['ros__parameters']['robot_names']
+        values = yaml.safe_load(stream)
+    names = values['/**']['ros__parameters']['robot_names']
+    fleet = values.get('/**/fleet_sim', {}).get('ros__parameters', {})
     logs = tempfile.mkdtemp(prefix='punctured_planner_demo_')
     bin_dir = os.path.dirname(sys.executable)
     params = args.params if args.drive is None else _with_drive(args.params, args.drive, logs)
@@ -249,7 +287,7 @@ def main(argv=None):
     code = 1
     try:
         recorder = Recorder(names)
-        code = _run(recorder, args.request, args.mcap, args.gif)
+        code = _run(recorder, args.request, args.mcap, args.gif, fleet)
     except KeyboardInterrupt:
         print('demo: interrupted')
     finally:

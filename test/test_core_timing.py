@@ -1,7 +1,12 @@
-"""Time parameterisation: the fastest robot of each leg at max_speed; breakpoints kept."""
+"""Time parameterisation: the fastest robot of each leg at max_speed, or under a limit a."""
 
+from hypothesis import given
+from hypothesis import settings
+from hypothesis import strategies as st
 import numpy as np
 from punctured_planner.core import plan, Workspace
+from punctured_planner.core.timing import corner_jump, speed_profile
+from punctured_planner.execution import Reference
 import pytest
 
 REQUEST = [[[0.5, 1.0], [0.5, -2.0]], [[3.0, 0.5], [-1.0, 2.0]]]
@@ -48,3 +53,132 @@ def test_no_pose_twice_and_every_configuration_exact(samples_per_leg, variant):
     # Nothing is lost: the motion through the samples is the plan's motion.
     taus = np.interp(samples.values, p.stamps(0.5), p.times)
     assert np.allclose(samples.positions, p.position(taus))
+
+
+# ---------------------------------------------------------------- acceleration limit
+
+OBSTACLES = [[-2.0, 0.5], [0.0, -0.5], [2.5, 0.0]]
+DEMO = np.array([[[-3.0, -2.0], [-1.0, -2.5], [1.0, -2.0], [3.0, -2.5]],
+                 [[3.0, 3.0], [1.0, 3.5], [-1.0, 3.0], [-3.0, 3.5]]])
+
+
+def todays_stamps(positions, max_speed):
+    """Return the law before the acceleration limit, written out: each leg at max_speed."""
+    steps = np.diff(positions, axis=0)
+    lengths = np.sqrt(np.einsum('vkd,vkd->vk', steps, steps)).max(axis=1)
+    return np.concatenate([[0.0], np.cumsum(lengths / max_speed)])
+
+
+@pytest.mark.parametrize('refine', [False, True])
+def test_zero_acceleration_keeps_todays_stamps_bit_for_bit(refine):
+    """max_acceleration 0 is unlimited: the stamps and samples of the law without it."""
+    p = plan(Workspace(OBSTACLES, robot_radius=0.1, variant='discs'), DEMO, refine=refine)
+    for speed in (0.5, 1.0, 3.7):
+        assert np.array_equal(p.stamps(speed, 0.0), todays_stamps(p.positions, speed))
+        assert p.duration(speed, 0.0) == todays_stamps(p.positions, speed)[-1]
+        samples = p.sample(3, speed, 0.0)
+        breakpoints = np.unique(todays_stamps(p.positions, speed))
+        assert np.array_equal(samples.values[::4], breakpoints)
+        inner = breakpoints[:-1, None] + np.diff(breakpoints)[:, None] * (np.arange(4) / 4)
+        assert np.array_equal(samples.values[:-1], inner.ravel())
+
+
+polylines = st.tuples(st.integers(0, 2 ** 32 - 1), st.integers(2, 12), st.integers(1, 4),
+                      st.sampled_from([0.0, 0.3, 1.0]))
+
+
+def random_polyline(seed, vertices, robots, repeat):
+    """Random (V, k, 2) breakpoints; with repeat > 0 some legs have no motion, some tiny."""
+    rng = np.random.default_rng(seed)
+    positions = np.cumsum(rng.normal(size=(vertices, robots, 2)), axis=0)
+    for leg in range(1, vertices):
+        if rng.uniform() < repeat:
+            positions[leg] = positions[leg - 1] + rng.choice([0.0, 1e-9])
+    return positions
+
+
+@settings(max_examples=150, deadline=None)
+@given(polylines, st.floats(0.05, 5.0), st.floats(0.05, 5.0), st.floats(0.0, 1.0))
+def test_profile_respects_both_limits_and_every_corner(line, speed, acceleration, jump):
+    """At rest at both ends, speed <= max_speed, |sigma''| <= a, corner jumps <= jump."""
+    positions = random_polyline(*line)
+    profile = speed_profile(positions, speed, acceleration, jump)
+    speeds, lengths = profile.speeds, profile.lengths
+    assert speeds[0] == 0.0 and speeds[-1] == 0.0
+    assert np.all(speeds <= speed) and np.all(speeds >= 0)
+    assert np.all(np.abs(np.diff(speeds ** 2)) <= 2 * acceleration * lengths + 1e-9)
+    durations = profile.durations()
+    assert np.all(durations >= lengths / speed - 1e-12)
+    moving = np.flatnonzero(lengths > 0)
+    rates = np.diff(positions, axis=0)[moving] / lengths[moving][:, None, None]
+    # every robot's velocity jump at a corner: its change of rate x sigma's speed there
+    jumps = np.linalg.norm(np.diff(rates, axis=0), axis=2).max(axis=1) * speeds[moving[1:]]
+    assert np.all(jumps <= jump + 1e-9)
+    for leg in moving:
+        times = np.linspace(0.0, durations[leg], 41)
+        states = [profile.state_at(leg, t) for t in times]
+        distance = np.array([state.distance for state in states])
+        assert np.all(np.diff(distance) >= -1e-12) and np.isclose(distance[-1], lengths[leg])
+        assert np.isclose(states[0].speed, speeds[leg])
+        assert np.isclose(states[-1].speed, speeds[leg + 1])
+        assert max(state.speed for state in states) <= speed + 1e-9
+        assert max(abs(state.acceleration) for state in states) <= acceleration
+        # time_at inverts state_at
+        assert np.allclose(profile.time_at(leg, distance), times, atol=1e-6 * (1 + times))
+
+
+def test_corners_are_slowed_into_and_straight_runs_are_not():
+    """A right angle is passed at jump / sqrt 2; a straight joint at full speed."""
+    square = np.array([[[0.0, 0.0]], [[4.0, 0.0]], [[8.0, 0.0]], [[8.0, 4.0]]])
+    profile = speed_profile(square, 1.0, 1.0, 0.2)
+    assert profile.speeds[1] == 1.0                      # collinear, same rate: no corner
+    assert np.isclose(profile.speeds[2], 0.2 / np.sqrt(2))
+    # the straight 8 m: 1 s (0.5 m) up to speed, cruising, then braking to the corner speed
+    corner = profile.speeds[2]
+    assert np.isclose(profile.stamps()[2], 1.0 + (8.0 - 0.5 - (1 - corner ** 2) / 2)
+                      + (1 - corner))
+
+
+def test_resampled_stamps_follow_the_profile_and_keep_every_breakpoint():
+    """Samples are evenly spaced along each leg, stamped where the profile reaches them."""
+    p = plan(Workspace(OBSTACLES, robot_radius=0.1, variant='discs'), DEMO)
+    stamps = p.stamps(1.0, 1.0)
+    assert p.duration(1.0, 1.0) > p.duration(1.0)
+    samples = p.sample(3, 1.0, 1.0)
+    assert np.all(np.diff(samples.values) > 0)
+    assert np.array_equal(samples.positions[samples.waypoints], DEMO)
+    assert samples.values[-1] == stamps[-1]
+    assert np.array_equal(np.unique(np.intersect1d(samples.values, stamps)),
+                          np.unique(stamps))
+    # the executor's profile of the samples puts each sample where the plan's profile does
+    xyz = np.concatenate([samples.positions, np.zeros(samples.positions.shape[:2] + (1,))], -1)
+    reference = Reference.timed(samples.values, xyz,
+                                np.tile([0.0, 0.0, 0.0, 1.0], xyz.shape[:2] + (1,)), 1.0, 1.0,
+                                p.min_gap)
+    breakpoints = Reference.timed(stamps, np.concatenate(
+        [p.positions, np.zeros(p.positions.shape[:2] + (1,))], -1),
+        np.tile([0.0, 0.0, 0.0, 1.0], p.positions.shape[:2] + (1,)), 1.0, 1.0, p.min_gap)
+    for s in np.linspace(0.0, stamps[-1], 301):
+        assert np.allclose(reference.position(s), breakpoints.position(s), atol=1e-7)
+        assert np.allclose(reference.velocity(s), breakpoints.velocity(s), atol=1e-5)
+
+
+def test_timed_reference_is_exact_at_stamps_and_followable_between():
+    """Poses at their stamps; velocity continuous inside intervals, |acceleration| <= a."""
+    p = plan(Workspace(OBSTACLES, robot_radius=0.1, variant='discs'), DEMO)
+    samples = p.sample(0, 1.0, 0.8)
+    xyz = np.concatenate([samples.positions, np.zeros(samples.positions.shape[:2] + (1,))], -1)
+    reference = Reference.timed(samples.values, xyz,
+                                np.tile([0.0, 0.0, 0.0, 1.0], xyz.shape[:2] + (1,)), 1.0, 0.8,
+                                p.min_gap)
+    for j, s in enumerate(samples.values):
+        assert np.array_equal(reference.position(s), xyz[j])
+    times = np.linspace(0.0, reference.duration, 4001)
+    velocities = np.array([reference.velocity(s) for s in times])
+    accelerations = np.array([reference.acceleration(s) for s in times])
+    assert np.linalg.norm(velocities, axis=2).max() <= 1.0 + 1e-9
+    assert np.linalg.norm(accelerations, axis=2).max() <= 0.8 + 1e-9
+    jumps = np.linalg.norm(np.diff(velocities, axis=0), axis=2).max(axis=1)
+    # between grid points a velocity changes by a dt, or by at most a corner's jump
+    assert jumps.max() <= corner_jump(0.8, p.min_gap) + 0.8 * np.diff(times)[0] + 1e-9
+    assert np.array_equal(reference.velocity(reference.duration), np.zeros((4, 3)))

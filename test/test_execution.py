@@ -120,8 +120,12 @@ def test_stale_odometry_holds_the_clock_and_it_resumes():
     assert step.rate == 1.0 and step.plan_time == pytest.approx(0.2)
 
 
-def certified_fleet(k=6, seed=2):
-    """Return (plan reference, Bodies, min gap): k robots crossing a row of pillars."""
+def certified_fleet(k=6, seed=2, acceleration=0.0):
+    """
+    Return (plan reference, Bodies, min gap): k robots crossing a row of pillars.
+
+    The stamps are at 0.5 m/s and under the acceleration limit (0: unlimited).
+    """
     rng = np.random.default_rng(seed)
     obstacles = np.array([[-2.0, 0.4], [0.2, -0.3], [2.5, 0.2]])
     start = np.c_[np.linspace(-3, 3, k) + rng.uniform(-0.2, 0.2, k), np.full(k, 2.5)]
@@ -132,18 +136,25 @@ def certified_fleet(k=6, seed=2):
                                axis=-1)
     radius = 0.1
     bodies = Bodies(radius, np.c_[obstacles, np.zeros(3)], np.zeros(3))
-    return reference_of(core.stamps(0.5), positions), bodies, core.min_clearance - 2 * radius
+    gap = core.min_clearance - 2 * radius
+    reference = Reference.timed(core.stamps(0.5, acceleration), positions,
+                                np.tile(IDENTITY, positions.shape[:2] + (1,)), 0.5,
+                                acceleration, gap)
+    return reference, bodies, gap
 
 
-def closed_loop(reference, bodies, gap, shared_clock, slow=0, late=1, limit=400.0):
+def closed_loop(reference, bodies, gap, shared_clock, slow=0, late=1, limit=400.0,
+                acceleration=0.0, adaptation=ExecutionSettings.feedforward_adaptation):
     """Run Execution at 20 Hz against a Fleet at 40 Hz; return (fleet, execution, seconds)."""
     k = reference.robot_count
     fleet = Fleet(reference.position(0.0), FleetSettings(
         bodies=bodies, speed_limit=0.5,
         speed_factors=np.where(np.arange(k) == slow, 0.5, 1.0),
-        latencies=np.where(np.arange(k) == late, 0.2, 0.0), velocity_noise=0.05, seed=3))
+        latencies=np.where(np.arange(k) == late, 0.2, 0.0), velocity_noise=0.05, seed=3,
+        max_acceleration=acceleration))
     execution = Execution(reference, tracking_tolerance(gap),
-                          ExecutionSettings(speed_limit=0.5, shared_clock=shared_clock),
+                          ExecutionSettings(speed_limit=0.5, shared_clock=shared_clock,
+                                            feedforward_adaptation=adaptation),
                           bodies)
     now = 0.0
     while now < limit:
@@ -167,6 +178,87 @@ def test_closed_loop_with_a_slow_and_a_late_robot_keeps_bodies_apart():
     assert np.linalg.norm(fleet.positions - reference.positions[-1], axis=1).max() <= 0.02
     # the slow robot needs twice the plan's time where it is the fastest mover
     assert reference.duration < seconds <= 1.5 * 2 * reference.duration
+
+
+def test_accelerations_limited_fleet_follows_a_plan_stamped_for_it():
+    """1 m/s^2 robots on stamps made for 1 m/s^2: within delta, gap >= 0, at the goal."""
+    reference, bodies, gap = certified_fleet(acceleration=1.0)
+    assert reference.profile is not None
+    fleet, execution, seconds = closed_loop(reference, bodies, gap, shared_clock=True,
+                                            acceleration=1.0)
+    assert fleet.min_gap >= 0
+    assert execution.max_errors.max() <= tracking_tolerance(gap)
+    assert np.linalg.norm(fleet.positions - reference.positions[-1], axis=1).max() <= 0.02
+    assert reference.duration < seconds <= 1.5 * 2 * reference.duration
+
+
+def test_feedforward_gain_learns_the_slow_robot():
+    """A robot that achieves half its commands gets about twice the feed-forward: faster."""
+    reference, bodies, gap = certified_fleet()
+    _, learning, learned = closed_loop(reference, bodies, gap, shared_clock=True)
+    _, fixed, unlearned = closed_loop(reference, bodies, gap, shared_clock=True, adaptation=0.0)
+    assert np.all(fixed.feedforward_gains == 1.0)
+    assert learning.feedforward_gains[0] > 1.5
+    assert np.all(np.delete(learning.feedforward_gains, 0) < learning.feedforward_gains[0])
+    assert learned < 0.9 * unlearned
+    assert learning.max_errors.max() <= tracking_tolerance(gap)
+
+
+def test_clock_speeds_up_within_the_plans_acceleration_limit():
+    """After a hold the clock rises by at most a dt / |r'| per step; without a limit at once."""
+    positions = np.array([[[0.0, 0.0, 0.0]], [[10.0, 0.0, 0.0]]])
+    timed = Reference.timed(np.array([0.0, 11.0]), positions,
+                            np.tile(IDENTITY, (2, 1, 1)), 1.0, 1.0, 1.0)
+    assert timed.duration == pytest.approx(11.0)
+    execution = Execution(timed, 0.5, ExecutionSettings(speed_limit=2.0))
+    for _ in range(40):
+        step = execution.step(0.05, timed.position(execution.plan_time), [False])
+    assert step.rate == 1.0
+    step = execution.step(0.05, timed.position(execution.plan_time), [True])
+    assert step.rate == 0.0, 'stale odometry still holds the clock at once'
+    speed = np.linalg.norm(timed.velocity(execution.plan_time))
+    step = execution.step(0.05, timed.position(execution.plan_time), [False])
+    assert step.rate == pytest.approx(1.0 * 0.05 / speed)
+    linear = reference_of([0.0, 10.0], positions)
+    unlimited = Execution(linear, 0.5, ExecutionSettings(speed_limit=2.0))
+    unlimited.step(0.05, linear.position(0.0), [True])
+    assert unlimited.step(0.05, linear.position(0.0), [False]).rate == 1.0
+
+
+def test_feedforward_includes_the_references_acceleration():
+    """On a speeding-up reference the command leads the velocity by a x rate^2 x dt."""
+    positions = np.array([[[0.0, 0.0, 0.0]], [[10.0, 0.0, 0.0]]])
+    timed = Reference.timed(np.array([0.0, 11.0]), positions,
+                            np.tile(IDENTITY, (2, 1, 1)), 1.0, 1.0, 1.0)
+    execution = Execution(timed, 0.5, ExecutionSettings(speed_limit=2.0, gain=0.0,
+                                                        feedforward_adaptation=0.0))
+    for _ in range(5):
+        step = execution.step(0.05, timed.position(execution.plan_time), [False])
+    rate, s = step.rate, step.plan_time
+    assert rate > 0
+    expected = rate * timed.velocity(s) + rate ** 2 * 0.05 * timed.acceleration(s)
+    assert np.allclose(step.velocities, expected)
+    assert timed.acceleration(s)[0, 0] == pytest.approx(1.0)
+
+
+def test_holonomic_acceleration_limit_one_value_per_robot():
+    """The executed velocity moves toward the command at most max_acceleration_i x dt."""
+    fleet = Fleet(np.zeros((3, 3)), FleetSettings(speed_limit=1.0,
+                                                  max_acceleration=np.array([1.0, 0.0, 4.0])))
+    for robot in range(3):
+        fleet.command(robot, [1.0, 0.0, 0.0], 0.0)
+    fleet.step(0.0, 0.1)
+    assert np.allclose(fleet.velocities[:, 0], [0.1, 1.0, 0.4])
+    for robot in range(3):
+        fleet.command(robot, [0.0, -1.0, 0.0], 0.1)
+    fleet.step(0.1, 0.1)
+    change = np.linalg.norm(fleet.velocities - [[0.1, 0, 0], [1.0, 0, 0], [0.4, 0, 0]], axis=1)
+    assert np.allclose(change[[0, 2]], [0.1, 0.4]) and np.allclose(fleet.velocities[1],
+                                                                   [0.0, -1.0, 0.0])
+    one = Fleet(np.zeros((2, 3)), FleetSettings(speed_limit=1.0, max_acceleration=2.0))
+    one.command(0, [1.0, 0.0, 0.0], 0.0)
+    one.step(0.0, 0.1)
+    assert np.allclose(one.velocities[0], [0.2, 0.0, 0.0])
 
 
 def test_without_the_shared_clock_the_slow_robot_falls_behind():
@@ -228,3 +320,32 @@ def test_plan_message_round_trip_to_the_executor_reference():
     message.paths[1].poses[2].header = Header(frame_id='map', stamp=conversions.time_from_ns(1))
     with pytest.raises(ValueError, match='robot_1'):
         conversions.plan_reference(message)
+
+
+def test_plan_message_carries_the_acceleration_limit_to_the_executor():
+    """A planner max_acceleration > 0: the stamps' profile, and the executor's rebuild of it."""
+    from planner_helpers import make_request
+    from punctured_planner.cli import offline_plan
+    from punctured_planner.ros import conversions
+    from punctured_planner.ros.settings import PLANNER
+    settings = PLANNER.settings({'obstacles': [-2.0, 0.5, 0.0, 0.0, -0.5, 0.0,
+                                               2.5, 0.0, 0.0], 'max_acceleration': 0.8})
+    outcome = offline_plan(make_request(max_speed=0.5), settings, now_ns=10 ** 18)
+    assert outcome.ok and outcome.max_acceleration == 0.8
+    message = conversions.plan_message(outcome, settings)
+    assert message.max_acceleration == 0.8 and message.max_speed == 0.5
+    duration = outcome.response.duration.sec + outcome.response.duration.nanosec * 1e-9
+    assert duration == pytest.approx(outcome.plan.duration(0.5, 0.8), abs=1e-9)
+    assert duration > outcome.plan.duration(0.5)
+    reference = conversions.plan_reference(message)
+    assert reference.profile is not None
+    assert reference.profile.max_acceleration == 0.8
+    samples = outcome.plan.sample(0, 0.5, 0.8)
+    assert np.allclose(reference.seconds, samples.values, atol=1e-8)
+    for j, s in enumerate(reference.seconds):
+        assert np.array_equal(reference.position(s), reference.positions[j])
+    unlimited = conversions.plan_reference(conversions.plan_message(
+        offline_plan(make_request(max_speed=0.5), PLANNER.settings(
+            {'obstacles': [-2.0, 0.5, 0.0, 0.0, -0.5, 0.0, 2.5, 0.0, 0.0]}),
+            now_ns=10 ** 18), settings))
+    assert unlimited.profile is None

@@ -49,6 +49,7 @@ EXPECTED_PLAN_FIELDS = {
     'robot_names': 'sequence<string>',
     'paths': 'sequence<nav_msgs/Path>',
     'max_speed': 'double',
+    'max_acceleration': 'double',
     'robot_radius': 'double',
     'obstacles': 'sequence<geometry_msgs/Point>',
     'obstacle_radii': 'sequence<double>',

@@ -133,10 +133,17 @@ def test_simulator_settings_become_the_fleet_physics():
     differential = FLEET_SIM.settings({
         'robot_names': ['a', 'b'], 'initial_positions': [0.0] * 6,
         'drive': ['holonomic', 'differential'], 'yaw_rate_limit': 1.9,
-        'max_acceleration': 1.0, 'max_yaw_acceleration': 4.0}).fleet()
+        'max_acceleration': [1.0], 'max_yaw_acceleration': 4.0}).fleet()
     assert differential.differential.tolist() == [False, True]
-    assert (differential.yaw_rate_limit, differential.max_acceleration,
-            differential.max_yaw_acceleration) == (1.9, 1.0, 4.0)
+    assert (differential.yaw_rate_limit, differential.max_yaw_acceleration) == (1.9, 4.0)
+    assert differential.max_acceleration.tolist() == [1.0, 1.0]
+    assert fleet.max_acceleration.tolist() == [0.0, 0.0]
+    each = FLEET_SIM.settings({'robot_names': ['a', 'b'], 'initial_positions': [0.0] * 6,
+                               'max_acceleration': [1.0, 0.5]}).fleet()
+    assert each.max_acceleration.tolist() == [1.0, 0.5]
+    with pytest.raises(ValueError, match='max_acceleration has 3 values for 2 robots'):
+        FLEET_SIM.settings({'robot_names': ['a', 'b'], 'initial_positions': [0.0] * 6,
+                            'max_acceleration': [1.0, 0.5, 2.0]})
     execution = EXECUTOR.settings({'drive': ['differential'], 'yaw_rate_limit': 1.9,
                                    'final_heading': 'none'}).execution
     assert execution.differential(3).tolist() == [True] * 3

@@ -59,7 +59,7 @@ DIFFERENTIAL = PARAMETERS.replace('max_speed: 1.0', 'max_speed: 0.3').replace(
     'speed_limit: 1.0', 'speed_limit: 0.3').replace(
     'speed_factors: [0.5, 1.0, 1.0]', 'speed_factors: [0.8, 1.0, 1.0]').replace(
     'velocity_noise: 0.05\n', 'velocity_noise: 0.05\n    drive: [differential]\n'
-    '    yaw_rate_limit: 1.9\n    max_acceleration: 1.0\n    max_yaw_acceleration: 8.0\n'
+    '    yaw_rate_limit: 1.9\n    max_acceleration: [1.0]\n    max_yaw_acceleration: 8.0\n'
 ).replace('discovery_timeout: 1.0\n', 'discovery_timeout: 1.0\n    drive: [differential]\n'
           '    yaw_rate_limit: 1.9\n')
 # The headings the differential robots are asked to end in (rad).

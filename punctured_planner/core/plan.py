@@ -25,7 +25,8 @@ from .refine import block_count, Bodies, refine as refine_motion, Refinement
 from .sections import compose, lane_heights, SCHEDULES, segment_times
 from .space import Workspace
 from .strata import epsilon, projection_count, projection_gaps
-from .timing import breakpoint_stamps, length_times, resample
+from .timing import (corner_jump, length_times, resample, speed_profile, SpeedProfile,
+                     stamps as timed_stamps)
 from .validation import validate_configurations
 from .walls import check_plan_inside
 
@@ -231,27 +232,52 @@ class Plan:
         # (1 - f) a + f b, not a + f (b - a): exact at both ends of every leg.
         return (1.0 - fraction) * self.positions[leg] + fraction * self.positions[leg + 1]
 
-    def stamps(self, max_speed: float) -> np.ndarray:
-        """Return (V,) seconds from the start at each breakpoint, fastest robot at max_speed."""
-        return breakpoint_stamps(self.positions, max_speed)
+    def profile(self, max_speed: float, max_acceleration: float,
+                positions: np.ndarray | None = None) -> SpeedProfile:
+        """
+        Return the SpeedProfile under both limits (doc/design.md section 8).
 
-    def duration(self, max_speed: float) -> float:
-        """Return the duration in seconds of the whole motion at max_speed."""
-        return float(self.stamps(max_speed)[-1])
+        positions default to the breakpoints; Plan.sample passes them without
+        the repeated ones, which leaves every stamp as it is.
+        """
+        return speed_profile(self.positions if positions is None else positions, max_speed,
+                             max_acceleration, corner_jump(max_acceleration, self.min_gap))
 
-    def sample(self, samples_per_leg: int, max_speed: float | None = None) -> Samples:
+    def stamps(self, max_speed: float, max_acceleration: float = 0.0) -> np.ndarray:
+        """
+        Return (V,) seconds from the start at each breakpoint, fastest robot at max_speed.
+
+        max_acceleration 0 (unlimited): each leg at max_speed throughout; else the
+        profile's stamps, at rest at both ends and slowed into the corners.
+        """
+        # the gap only matters to the corners of a limited profile: no certificate for 0
+        return timed_stamps(self.positions, max_speed, max_acceleration,
+                            self.min_gap if max_acceleration else 0.0)
+
+    def duration(self, max_speed: float, max_acceleration: float = 0.0) -> float:
+        """Return the duration in seconds of the whole motion under both limits."""
+        return float(self.stamps(max_speed, max_acceleration)[-1])
+
+    def sample(self, samples_per_leg: int, max_speed: float | None = None,
+               max_acceleration: float = 0.0) -> Samples:
         """
         Return the Samples: every distinct breakpoint and samples_per_leg more inside each leg.
 
         values are stamps in seconds when max_speed is given, else parameters tau.
         In stamps a leg where no robot moves lasts no time, so its end repeats its
-        start and is left out; in tau it still takes its share of [0, 1].
+        start and is left out; in tau it still takes its share of [0, 1]. Under an
+        acceleration limit the samples are evenly spaced along each leg and
+        stamped by the profile.
         """
-        values = self.times if max_speed is None else self.stamps(max_speed)
+        values = (self.times if max_speed is None
+                  else self.stamps(max_speed, max_acceleration))
         new = np.ones(values.size, dtype=bool)
         new[1:] = (values[1:] != values[:-1]) | np.any(
             self.positions[1:] != self.positions[:-1], axis=(1, 2))
-        values, positions, _ = resample(values[new], self.positions[new], samples_per_leg)
+        profile = (self.profile(max_speed, max_acceleration, self.positions[new])
+                   if max_speed is not None and max_acceleration > 0 else None)
+        values, positions, _ = resample(values[new], self.positions[new], samples_per_leg,
+                                        profile)
         kept = np.cumsum(new) - 1
         step = max(int(samples_per_leg), 0) + 1
         return Samples(values, positions, kept[self.waypoint_indices] * step)

@@ -3,10 +3,21 @@ Time parameterisation of a synchronous piecewise-linear motion (doc/design.md se
 
 Any reparameterisation common to all robots keeps the motion collision-free,
 so each leg gets the duration that lets its fastest robot move at max_speed.
+With an acceleration limit a (:class:`SpeedProfile`) the path length sigma
+(the fastest robot's displacement, summed over the legs) follows a speed
+profile with |sigma''| <= a, slowed into every corner so that no robot's
+velocity jumps there by more than :func:`corner_jump`.
 """
+
+from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import numpy.typing as npt
+
+# Share beta of the tracking tolerance delta a corner's velocity jump may cost: a robot of
+# acceleration a lags a jump dv by at most dv^2 / (2 a) (doc/design.md section 8).
+CORNER_SHARE = 0.1
 
 
 def leg_lengths(positions: np.ndarray) -> np.ndarray:
@@ -43,13 +54,158 @@ def breakpoint_stamps(positions: np.ndarray, max_speed: float) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(leg_lengths(positions) / max_speed)])
 
 
-def resample(values: npt.ArrayLike, positions: np.ndarray, samples_per_leg: int
+def corner_jump(max_acceleration: float, min_gap: float) -> float:
+    """
+    Return the largest velocity jump (m/s) a corner may give any robot of a plan.
+
+    A robot that accelerates at max_acceleration toward a velocity that
+    jumped by dv lags it by dv^2 / (2 a); this is the dv for which that lag is
+    CORNER_SHARE of the tracking tolerance delta = min_gap / 2.
+    """
+    return float(np.sqrt(2.0 * max_acceleration * CORNER_SHARE * max(min_gap, 0.0) / 2.0))
+
+
+@dataclass(frozen=True)
+class LegState:
+    """Where the fastest robot is along a leg: distance (m), speed (m/s), acceleration."""
+
+    distance: float
+    speed: float
+    acceleration: float
+
+
+@dataclass(frozen=True, eq=False)
+class SpeedProfile:
+    """
+    The speed of the path length sigma along a motion's legs, at rest at both ends.
+
+    lengths (L,) are the legs' lengths in sigma (the fastest robot's
+    displacement), speeds (L + 1,) sigma's speed at each breakpoint. Inside a
+    leg sigma accelerates at max_acceleration, cruises at most at max_speed,
+    then brakes at max_acceleration: the fastest bang-coast-bang between the
+    breakpoint speeds, which the passes of :func:`speed_profile` keep
+    reachable.
+    """
+
+    lengths: np.ndarray
+    speeds: np.ndarray
+    max_speed: float
+    max_acceleration: float
+
+    @cached_property
+    def _phases(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Return (L,) peak speeds, accelerating, cruising and braking times of every leg."""
+        a, start, end = self.max_acceleration, self.speeds[:-1], self.speeds[1:]
+        peak = np.minimum(self.max_speed,
+                          np.sqrt(0.5 * (start ** 2 + end ** 2) + a * self.lengths))
+        speeding, braking = (peak - start) / a, (peak - end) / a
+        cruise = self.lengths - (2.0 * peak ** 2 - start ** 2 - end ** 2) / (2.0 * a)
+        with np.errstate(divide='ignore', invalid='ignore'):
+            cruising = np.where(peak > 0, np.maximum(cruise, 0.0) / peak, 0.0)
+        return peak, speeding, cruising, braking
+
+    def durations(self) -> np.ndarray:
+        """Return the (L,) legs' durations in seconds."""
+        _, speeding, cruising, braking = self._phases
+        return speeding + cruising + braking
+
+    def stamps(self) -> np.ndarray:
+        """Return (L + 1,) seconds from the start at each breakpoint."""
+        return np.concatenate([[0.0], np.cumsum(self.durations())])
+
+    def time_at(self, leg: int, distances: np.ndarray) -> np.ndarray:
+        """Return the seconds from leg's start at which sigma has moved distances along it."""
+        a, start = self.max_acceleration, self.speeds[leg]
+        peak, speeding, cruising, _ = (phase[leg] for phase in self._phases)
+        reach = (peak ** 2 - start ** 2) / (2.0 * a)
+        x = np.clip(distances, 0.0, self.lengths[leg])
+        # 2x / (v0 + sqrt(v0^2 + 2ax)): the root of v0 t + a t^2 / 2 = x without cancellation
+        rising = 2.0 * x / np.maximum(start + np.sqrt(start ** 2 + 2.0 * a * x), 1e-300)
+        coasting = speeding + (x - reach) / max(peak, 1e-300)
+        left = np.maximum(x - reach - peak * cruising, 0.0)
+        falling = speeding + cruising + 2.0 * left / np.maximum(
+            peak + np.sqrt(np.maximum(peak ** 2 - 2.0 * a * left, 0.0)), 1e-300)
+        return np.where(x <= reach, rising,
+                        np.where(x <= reach + peak * cruising, coasting, falling))
+
+    def state_at(self, leg: int, seconds: float) -> LegState:
+        """Return sigma's LegState seconds after leg's start (clamped to the leg)."""
+        a, start = self.max_acceleration, float(self.speeds[leg])
+        peak, speeding, cruising, braking = (float(phase[leg]) for phase in self._phases)
+        t = min(max(seconds, 0.0), speeding + cruising + braking)
+        if t < speeding:
+            return LegState(start * t + 0.5 * a * t * t, start + a * t, a)
+        reach = start * speeding + 0.5 * a * speeding ** 2
+        if t < speeding + cruising:
+            return LegState(reach + peak * (t - speeding), peak, 0.0)
+        late = t - speeding - cruising
+        distance = reach + peak * cruising + peak * late - 0.5 * a * late * late
+        return LegState(min(distance, float(self.lengths[leg])), peak - a * late, -a)
+
+
+def speed_profile(positions: np.ndarray, max_speed: float, max_acceleration: float,
+                  jump: float) -> SpeedProfile:
+    """
+    Return the fastest SpeedProfile of positions (V, k, d) under both limits.
+
+    At rest at the first and the last breakpoint; at a breakpoint where the
+    robots' velocities per unit of sigma change by Delta (the largest over
+    the robots, across legs in which nothing moves), sigma's speed is at most
+    jump / Delta, so no robot's velocity jumps by more than jump. A forward and
+    a backward pass make every breakpoint speed reachable within its legs.
+    """
+    if not (max_speed > 0 and max_acceleration > 0):
+        raise ValueError('max_speed and max_acceleration must be positive')
+    lengths = leg_lengths(positions)
+    steps = np.diff(positions, axis=0)
+    moving = np.flatnonzero(lengths > 0)
+    caps = np.full(len(positions), float(max_speed))
+    caps[[0, -1]] = 0.0
+    if moving.size:
+        caps[:moving[0] + 1] = 0.0
+        caps[moving[-1] + 1:] = 0.0
+        rates = steps[moving] / lengths[moving][:, None, None]
+        change = np.linalg.norm(np.diff(rates, axis=0), axis=2).max(axis=1)
+        with np.errstate(divide='ignore', invalid='ignore'):
+            corner = np.where(change > 0, jump / change, np.inf)
+        for before, after, cap in zip(moving[:-1], moving[1:], corner):
+            # every breakpoint from the end of one moving leg to the start of the next
+            caps[before + 1:after + 1] = np.minimum(caps[before + 1:after + 1], cap)
+    speeds = caps.copy()
+    for leg in range(len(lengths)):
+        speeds[leg + 1] = min(speeds[leg + 1],
+                              np.sqrt(speeds[leg] ** 2 + 2 * max_acceleration * lengths[leg]))
+    for leg in range(len(lengths) - 1, -1, -1):
+        speeds[leg] = min(speeds[leg],
+                          np.sqrt(speeds[leg + 1] ** 2 + 2 * max_acceleration * lengths[leg]))
+    return SpeedProfile(lengths, speeds, float(max_speed), float(max_acceleration))
+
+
+def stamps(positions: np.ndarray, max_speed: float, max_acceleration: float,
+           min_gap: float) -> np.ndarray:
+    """
+    Return (V,) seconds at each breakpoint of positions (V, k, d): the timing law.
+
+    max_acceleration 0 (unlimited): each leg at max_speed throughout
+    (:func:`breakpoint_stamps`); else the fastest SpeedProfile, its corners'
+    jumps from min_gap (:func:`corner_jump`).
+    """
+    if max_acceleration == 0:
+        return breakpoint_stamps(positions, max_speed)
+    return speed_profile(positions, max_speed, max_acceleration,
+                         corner_jump(max_acceleration, min_gap)).stamps()
+
+
+def resample(values: npt.ArrayLike, positions: np.ndarray, samples_per_leg: int,
+             profile: SpeedProfile | None = None
              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """
     Insert samples_per_leg evenly spaced samples inside every leg.
 
-    values (V,) are breakpoint parameters or stamps (both linear inside a
-    leg), positions (V, k, d). Returns (values (M,), positions (M, k, d),
+    values (V,) are breakpoint parameters or stamps, positions (V, k, d).
+    Without a profile the values are linear inside a leg; with one (stamps
+    under an acceleration limit) each sample's stamp is the profile's time at
+    its distance along the leg. Returns (values (M,), positions (M, k, d),
     is_breakpoint (M,) bool); every breakpoint is kept exactly.
     """
     values = np.asarray(values, dtype=float)
@@ -57,7 +213,12 @@ def resample(values: npt.ArrayLike, positions: np.ndarray, samples_per_leg: int
         return values, positions, np.ones(values.size, dtype=bool)
     fractions = np.arange(samples_per_leg + 1) / (samples_per_leg + 1)
     start_values, start_positions = values[:-1], positions[:-1]
-    inner_values = start_values[:, None] + np.diff(values)[:, None] * fractions[None, :]
+    if profile is None:
+        inner_values = start_values[:, None] + np.diff(values)[:, None] * fractions[None, :]
+    else:
+        inner_values = start_values[:, None] + np.array(
+            [profile.time_at(leg, fractions * length)
+             for leg, length in enumerate(profile.lengths)]).reshape(-1, fractions.size)
     inner_positions = (start_positions[:, None]
                        + np.diff(positions, axis=0)[:, None] * fractions[None, :, None, None])
     # Fraction 0 is the breakpoint itself: copy it so it stays bit for bit.

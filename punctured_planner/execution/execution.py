@@ -7,11 +7,13 @@ Each step (doc/design.md section 13; msg_docs/ExecutePlan.md):
    current plan time s;
 2. choose the clock rate: 0 while any robot's odometry is stale, else
    :func:`clock_rate` of the errors and the tracking tolerance (with
-   ``shared_clock`` off, 1: every robot follows the stamps on its own);
+   ``shared_clock`` off, 1: every robot follows the stamps on its own),
+   rising no faster than the plan's acceleration limit allows;
 3. advance s by rate x dt (at most the plan's duration);
 4. command each robot feed-forward plus feedback, saturated at its speed
-   limit: v = sat(rate x reference'(s) + gain x (reference(s) - position)).
-   A stale robot gets 0.
+   limit: v = sat(g (rate x reference'(s) + rate^2 dt x reference''(s))
+   + gain x (reference(s) - position)), g the robot's learned feed-forward
+   gain. A stale robot gets 0.
 
 Differential robots (``drive``) track through :mod:`.unicycle` instead: the
 clock sees the bound E = |reference - P| + e of each one's centre error, is
@@ -37,6 +39,11 @@ from .tolerance import clock_rate
 
 # Longest step the clock takes at once (s): a stalled control loop does not jump ahead.
 MAX_STEP = 0.2
+# Largest feed-forward gain: a robot that achieves a quarter of its commands is not helped.
+MAX_FEEDFORWARD_GAIN = 4.0
+# Reference speed (m/s) below which a robot's lag says nothing about its feed-forward
+# (and the clock's rise counts the reference as moving this fast).
+ADAPT_SPEED = 0.05
 HOLONOMIC = 'holonomic'
 DIFFERENTIAL = 'differential'
 DRIVES = (HOLONOMIC, DIFFERENTIAL)
@@ -55,6 +62,8 @@ class ExecutionSettings:
     drive: tuple = (HOLONOMIC,)         # one value, or one per robot in plan order
     yaw_rate_limit: float = 1.0         # rad/s, differential robots
     final_heading: bool = True          # differential robots end facing their last pose
+    # 1/s: how fast each robot's feed-forward gain learns its lag along its reference; 0: off
+    feedforward_adaptation: float = 0.3
 
     def differential(self, robot_count: int) -> np.ndarray:
         """Return the (k,) mask of differential robots; ValueError if drive does not fit k."""
@@ -85,7 +94,7 @@ class Step:
     yaw_rates: np.ndarray       # (k,) differential robots' yaw rates (rad/s), else 0
 
 
-def saturate(velocities: np.ndarray, limit: float) -> np.ndarray:
+def saturate(velocities: np.ndarray, limit: float | np.ndarray) -> np.ndarray:
     """Return (k, 3) velocities scaled down to speed at most limit, direction kept."""
     speeds = np.linalg.norm(velocities, axis=-1, keepdims=True)
     scale = np.minimum(1.0, limit / np.maximum(speeds, np.finfo(float).tiny))
@@ -115,6 +124,9 @@ class Execution:
         # robots driving backward: their lead point is e behind, their 'heading' theta + pi
         self.reverse = np.zeros(reference.robot_count, dtype=bool)
         self.settled = 0.0     # seconds every final heading has been reached for
+        # (k,) what each robot's feed-forward is multiplied by: 1 until it lags (_feedforward)
+        self.feedforward_gains = np.ones(reference.robot_count)
+        self.rate = 0.0        # the clock's last rate
 
     def step(self, dt: float, positions: np.ndarray, stale: np.ndarray,
              orientations: np.ndarray | None = None) -> Step:
@@ -153,16 +165,20 @@ class Execution:
         elif stale.any():
             rate = 0.0
         else:
-            rate = min(clock_rate(watched, self.tolerance, s.slow_fraction, s.hold_fraction),
-                       self._differential_cap(alpha, dt))
+            rate = self._rate_rise(
+                min(clock_rate(watched, self.tolerance, s.slow_fraction, s.hold_fraction),
+                    self._differential_cap(alpha, dt)), dt)
+        self.rate = rate
         duration = self.reference.duration
         self.plan_time = min(duration, self.plan_time + rate * dt)
         target = self.reference.position(self.plan_time)
-        command = rate * self.reference.velocity(self.plan_time) + s.gain * (target - positions)
+        feedforward = self._feedforward(rate, dt, reference_now - positions, stale)
+        command = feedforward + s.gain * (target - positions)
         velocities = saturate(command, s.speed_limit)
         forward, yaw_rates = np.zeros(k), np.zeros(k)
         if unicycles:
-            unicycle_command = self._unicycle(rate, target, positions, angles, driving, alpha)
+            unicycle_command = self._unicycle(feedforward, target, positions, angles, driving,
+                                              alpha)
             forward = np.where(differential, unicycle_command.forward, 0.0)
             yaw_rates = np.where(differential, unicycle_command.yaw_rate, 0.0)
             velocities = np.where(differential[:, None],
@@ -173,6 +189,54 @@ class Execution:
         finished = self._settled(arrived, angles, dt) and arrived
         return Step(self.plan_time, rate, target, self.reference.orientation(self.plan_time),
                     velocities, errors, finished, self.differential.copy(), forward, yaw_rates)
+
+    def _rate_rise(self, wanted: float, dt: float) -> float:
+        """
+        Return wanted, or less where the clock would speed up faster than the plan allows.
+
+        Under the plan's acceleration limit a, the clock rises no faster than
+        lets the fastest reference's velocity rate x r'(s) grow by a dt: released
+        from a hold at once, every robot limited to a would lag its reference's
+        jump by up to v^2 / (2 a) and hold the clock again. It still slows and
+        holds at once. A plan without the limit keeps the clock's rate as it is.
+        """
+        profile = self.reference.profile
+        if profile is None:
+            return wanted
+        speed = float(np.linalg.norm(self.reference.velocity(self.plan_time), axis=1).max())
+        return min(wanted, self.rate + profile.max_acceleration * dt / max(speed, ADAPT_SPEED))
+
+    def _feedforward(self, rate: float, dt: float, lags: np.ndarray,
+                     stale: np.ndarray) -> np.ndarray:
+        """
+        Return the (k, 3) feed-forward velocities at the clock's new plan time.
+
+        The reference's velocity plus its acceleration over one control step
+        (an acceleration-limited base answers a command about a step late),
+        times the clock rate, times each robot's feed-forward gain. A gain
+        grows while its robot lags behind a moving reference by more than
+        slow_fraction delta, so far that the clock waits for it (lags (k, 3)
+        are reference - position when measured; a lag below that, from latency,
+        odometry age or a corner, is left to the feedback), and shrinks back
+        toward 1 while it is ahead: a robot that achieves only a fraction f of
+        its commands gets about 1 / f of the feed-forward and keeps the pace
+        the clock sets instead of the much lower K e of its feedback alone.
+        With the clock held (rate 0) there is no feed-forward, so the hold's
+        argument (doc/design.md section 13) is unchanged.
+        """
+        s_now = self.plan_time
+        velocity = self.reference.velocity(s_now)
+        feedforward = rate * velocity + rate * rate * dt * self.reference.acceleration(s_now)
+        speeds = np.linalg.norm(velocity, axis=1)
+        moving = (rate * speeds > ADAPT_SPEED) & ~stale
+        along = np.einsum('kd,kd->k', lags, velocity) / np.maximum(speeds, ADAPT_SPEED)
+        waited = self.settings.slow_fraction * self.tolerance
+        excess = np.where(along > waited, along - waited, np.minimum(along, 0.0))
+        change = self.settings.feedforward_adaptation * dt * excess / self.tolerance
+        self.feedforward_gains = np.clip(
+            np.where(moving, self.feedforward_gains + change, self.feedforward_gains),
+            1.0, MAX_FEEDFORWARD_GAIN)
+        return self.feedforward_gains[:, None] * feedforward
 
     def _settled(self, arrived: bool, angles: np.ndarray, dt: float) -> bool:
         """Return whether every differential robot has faced its final heading for SETTLE s."""
@@ -233,13 +297,14 @@ class Execution:
         caps = np.minimum(caps, self.corners.corner_caps(s_now, self.steering, limit))
         return float(np.min(caps[self.differential], initial=1.0))
 
-    def _unicycle(self, rate: float, target: np.ndarray, positions: np.ndarray,
+    def _unicycle(self, feedforward: np.ndarray, target: np.ndarray, positions: np.ndarray,
                   angles: np.ndarray, driving: np.ndarray,
                   alpha: np.ndarray) -> unicycle.UnicycleCommand:
         """
         Return every robot's unicycle command: follow, turn, park or face the final pose.
 
-        angles are the yaws, driving the driving headings (yaw + pi backward).
+        feedforward (k, 3) is :meth:`_feedforward`'s, angles are the yaws,
+        driving the driving headings (yaw + pi backward), alpha the misalignments.
         """
         s = self.settings
         if self.plan_time >= self.reference.duration:
@@ -251,8 +316,7 @@ class Execution:
             return unicycle.UnicycleCommand(np.where(parked, 0.0, command.forward),
                                             np.where(parked, final, command.yaw_rate))
         lead_points = unicycle.lead_points(positions, driving, self.lead)
-        desired = rate * self.reference.velocity(self.plan_time) + s.gain * (target
-                                                                             - lead_points)
+        desired = feedforward + s.gain * (target - lead_points)
         command = unicycle.follow(desired, driving, self.steering, s.speed_limit,
                                   s.yaw_rate_limit)
         forward = np.where(self.reverse, -command.forward, command.forward)

@@ -18,7 +18,8 @@ Conventions:
   out (the core's Plan.sample), so stamps strictly increase. All robots'
   paths share the same stamps: start + the time parameterisation at
   max_speed (each leg lasts long enough that its fastest robot moves at
-  max_speed).
+  max_speed) and, when set, the planner's max_acceleration (the speed
+  profile of doc/design.md section 8; the Plan message carries both).
 * Orientation rule: at waypoint C_m a robot has the orientation of its input
   pose in C_m; between C_m and C_{m+1} it holds the orientation of C_m (the
   last waypoint passed). A zero-length or non-finite input quaternion counts
@@ -336,6 +337,7 @@ def plan_message(outcome, settings):
     min_gap = float(outcome.plan.min_gap)
     return Plan(plan_id=int(outcome.plan_id), robot_names=list(outcome.names),
                 paths=list(outcome.paths), max_speed=float(outcome.max_speed),
+                max_acceleration=float(outcome.max_acceleration),
                 robot_radius=float(workspace.robot_radius), obstacles=obstacles,
                 obstacle_radii=np.asarray(workspace.obstacle_radii, dtype=float).tolist(),
                 min_gap=min_gap, tracking_tolerance=tracking_tolerance(min_gap))
@@ -368,7 +370,8 @@ def plan_reference(msg):
     seconds = (stamps[0] - stamps[0][0]) * 1e-9
     positions = np.stack([a[1] for a in arrays], axis=1)
     orientations = normalized_quaternions(np.stack([a[2] for a in arrays], axis=1))
-    return Reference(seconds, positions, orientations)
+    return Reference.timed(seconds, positions, orientations, float(msg.max_speed),
+                           float(msg.max_acceleration), float(msg.min_gap))
 
 
 def plan_bodies(msg):

@@ -130,18 +130,19 @@ class PlanSequenceHandler:
         """Step 4: stamps, paths and the filled response; return the Outcome."""
         planning_time = time.perf_counter() - started
         start_ns = int(now_ns) + int(round(planning_time * 1e9))
-        max_speed = gathered.max_speed
+        max_speed, max_acceleration = gathered.max_speed, settings.max_acceleration
         # The plan's own breakpoints: the refinement's knots add to any schedule's.
         checks.check_poses(settings, gathered.counts[0], len(the_plan.times),
                            gathered.samples_per_leg)
         with np.errstate(over='ignore', divide='ignore', invalid='ignore'):
-            duration = the_plan.duration(max_speed)
+            duration = the_plan.duration(max_speed, max_acceleration)
         checks.check_duration(duration, max_speed, start_ns)
-        samples = the_plan.sample(gathered.samples_per_leg, max_speed)
+        samples = the_plan.sample(gathered.samples_per_leg, max_speed, max_acceleration)
         paths = conversions.plan_to_paths(samples, checked.orientations, settings.frame_id,
                                           start_ns, settings.plane_z)
         conversions.fill_response(response, the_plan, paths, planning_time, duration,
                                   samples.waypoints, checked.dropped)
         return Outcome(response=response, plan=the_plan, paths=paths,
                        names=conversions.robot_names(settings.robot_names, gathered.counts[0]),
-                       start_ns=start_ns, max_speed=max_speed, dropped=checked.dropped)
+                       start_ns=start_ns, max_speed=max_speed,
+                       max_acceleration=max_acceleration, dropped=checked.dropped)

@@ -107,6 +107,12 @@ class PlannerSettings:
         'max_speed', 'double', 1.0,
         "Speed of the fastest robot on each leg (m/s) when a request's max_speed is "
         '<= 0.', low=1e-6, high=1e6).field()
+    max_acceleration: float = Spec(
+        'max_acceleration', 'double', 0.0,
+        "Acceleration limit of every robot (m/s^2) the stamps respect: each leg's speed "
+        'rises and falls at most this fast, at rest at the start and the end, slowed into '
+        'every corner (doc/design.md section 8); 0: unlimited, every leg at max_speed.',
+        low=0.0, high=1e6).field()
     samples_per_leg: int = Spec(
         'samples_per_leg', 'integer', 0,
         "Extra poses between consecutive breakpoints when a request's samples_per_leg "
@@ -263,6 +269,12 @@ class ExecutorSettings:
         "'request': after the plan's end every differential robot turns in place to the "
         "orientation of its last pose (the request's; identity faces +x); 'none': it "
         'stops facing where it arrived.', choices=('request', 'none')).field()
+    feedforward_adaptation: float = Spec(
+        'feedforward_adaptation', 'double', 0.3,
+        "How fast (1/s) each robot's feed-forward gain grows while it lags behind its "
+        'moving reference by more than slow_fraction of the tolerance (and falls back '
+        'toward 1 while it is ahead), up to 4: a robot that achieves a fraction f of its '
+        'commands gets about 1/f of the feed-forward; 0: off.', low=0.0, high=100.0).field()
 
     @property
     def execution(self) -> ExecutionSettings:
@@ -273,7 +285,8 @@ class ExecutorSettings:
                                  goal_tolerance=self.goal_tolerance,
                                  shared_clock=self.shared_clock == 'on', drive=self.drive,
                                  yaw_rate_limit=self.yaw_rate_limit,
-                                 final_heading=self.final_heading == 'request')
+                                 final_heading=self.final_heading == 'request',
+                                 feedforward_adaptation=self.feedforward_adaptation)
 
 
 def _slow_below_hold(settings: ExecutorSettings) -> None:
@@ -337,11 +350,12 @@ class FleetSimSettings:
         prose='names among robot_names').field()
     drive: tuple = DRIVE.field()
     yaw_rate_limit: float = YAW_RATE_LIMIT.field()
-    max_acceleration: float = Spec(
-        'max_acceleration', 'double', 0.0,
-        "Differential robots' linear acceleration limit (m/s^2): the executed forward "
-        'speed moves toward the command at most this fast; 0: at once.',
-        low=0.0, high=1e3).field()
+    max_acceleration: tuple = Spec(
+        'max_acceleration', 'double_array', [],
+        "The robots' linear acceleration limit (m/s^2), one value for all or one per "
+        'robot: the executed velocity (holonomic) or forward speed (differential) moves '
+        'toward the command at most this fast; 0 or empty: at once.',
+        check=within(0.0, 1e3), prose='empty, one, or one per robot, in [0, 1000]').field()
     max_yaw_acceleration: float = Spec(
         'max_yaw_acceleration', 'double', 0.0,
         "Differential robots' yaw acceleration limit (rad/s^2); 0: at once.",
@@ -364,7 +378,9 @@ class FleetSimSettings:
             latencies=np.asarray(self.latencies) if self.latencies else None,
             velocity_noise=self.velocity_noise, command_timeout=self.command_timeout,
             seed=self.seed, differential=differential_mask(self.drive, len(self.robot_names)),
-            yaw_rate_limit=self.yaw_rate_limit, max_acceleration=self.max_acceleration,
+            yaw_rate_limit=self.yaw_rate_limit,
+            max_acceleration=np.broadcast_to(self.max_acceleration or 0.0,
+                                             len(self.robot_names)).copy(),
             max_yaw_acceleration=self.max_yaw_acceleration)
 
 
@@ -379,6 +395,9 @@ def _fleet_counts(settings: FleetSimSettings) -> None:
         if values and len(values) != count:
             raise ValueError('%s has %d values for %d robots' % (name, len(values), count))
     differential_mask(settings.drive, count)
+    if len(settings.max_acceleration) not in (0, 1, count):
+        raise ValueError('max_acceleration has %d values for %d robots (0, 1 or one each)'
+                         % (len(settings.max_acceleration), count))
     unknown = [name for name in settings.muted_robots if name not in settings.robot_names]
     if unknown:
         raise ValueError('muted_robots names %s, not among robot_names' % ', '.join(unknown))

@@ -91,6 +91,7 @@ class Outcome:
     names: list[str] | None = None
     start_ns: int = 0
     max_speed: float = 0.0
+    max_acceleration: float = 0.0  # the stamps' acceleration limit (0: unlimited)
     exception: BaseException | None = None
     dropped: list[int] | None = None  # request configurations that repeated the state
     plan_id: int = 0  # the id the node published the plan under (0: not published)

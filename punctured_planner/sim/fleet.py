@@ -8,9 +8,11 @@ Per robot i and step dt, with the latest command whose latency has passed
   the command's linear velocity is applied as it is (the executor rotates
   world velocities into each robot's body frame from its odometry orientation):
 
-      v_i = speed_factor_i * sat(command, speed_limit) * (1 + velocity_noise * xi),
+      u_i moves toward sat(command, speed_limit) by at most max_acceleration_i dt,
+      v_i = speed_factor_i * u_i * (1 + velocity_noise * xi),
 
-  xi standard normal per axis; the centre moves by v_i dt on a straight line;
+  xi standard normal per axis (max_acceleration 0: u_i is the command at
+  once); the centre moves by v_i dt on a straight line;
 * differential (a unicycle): only linear.x and angular.z count (linear.y is
   ignored, as on a real base); each is clipped to its limit, then moves toward
   it at most by its acceleration limit times dt (0: at once), then is scaled by
@@ -47,7 +49,8 @@ class FleetSettings:
     seed: int = 0
     differential: np.ndarray | None = None    # (k,) bool, None: all holonomic
     yaw_rate_limit: float = 1.0               # rad/s, differential robots
-    max_acceleration: float = 0.0             # m/s^2, differential robots; 0: unlimited
+    # m/s^2 on the commanded velocity: one value or (k,), one per robot; 0: unlimited
+    max_acceleration: float | np.ndarray = 0.0
     max_yaw_acceleration: float = 0.0         # rad/s^2, differential robots; 0: unlimited
 
 
@@ -76,6 +79,7 @@ class Fleet:
         self.yaw_rates = np.zeros(k)      # executed yaw rates, differential robots
         self._moves = np.zeros((k, 3))    # the last step's chords, differential robots
         self._ramped = np.zeros((k, 2))   # (forward, yaw rate) after the acceleration limits
+        self._linear = np.zeros((k, 3))   # holonomic velocities after the acceleration limit
         # (apply_time, linear velocity (3,), yaw rate)
         self._pending: list[deque] = [deque() for _ in range(k)]
         self._active = np.zeros((k, 4))
@@ -95,6 +99,8 @@ class Fleet:
                           else np.asarray(settings.latencies, dtype=float))
         self.differential = (np.zeros(k, dtype=bool) if settings.differential is None
                              else np.asarray(settings.differential, dtype=bool))
+        self.accelerations = np.broadcast_to(
+            np.asarray(settings.max_acceleration, dtype=float), k).copy()
 
     @property
     def robot_count(self) -> int:
@@ -128,7 +134,7 @@ class Fleet:
         s = self.settings
         wanted = np.c_[np.clip(commanded[:, 0], -s.speed_limit, s.speed_limit),
                        np.clip(commanded[:, 3], -s.yaw_rate_limit, s.yaw_rate_limit)]
-        limits = np.array([s.max_acceleration, s.max_yaw_acceleration]) * dt
+        limits = np.c_[self.accelerations, np.full(len(wanted), s.max_yaw_acceleration)] * dt
         change = wanted - self._ramped
         self._ramped = np.where(limits > 0, self._ramped + np.clip(change, -limits, limits),
                                 wanted)
@@ -144,11 +150,19 @@ class Fleet:
         self.headings = wrap(self.headings + turned)
         return np.abs(forward * dt * turned) / 8.0
 
+    def _ramp(self, wanted: np.ndarray, dt: float) -> np.ndarray:
+        """Return the (k, 3) holonomic velocities moved toward wanted within the limits."""
+        change = wanted - self._linear
+        limits = self.accelerations[:, None] * dt
+        self._linear = np.where(self.accelerations[:, None] > 0,
+                                self._linear + saturate(change, limits), wanted)
+        return self._linear
+
     def step(self, now: float, dt: float) -> list:
         """Move every robot for dt seconds from time now; return the new Contacts."""
         s = self.settings
         commanded = self._commanded(now)
-        linear = saturate(commanded[:, :3], s.speed_limit)
+        linear = self._ramp(saturate(commanded[:, :3], s.speed_limit), dt)
         noise = 1.0 + s.velocity_noise * self._rng.standard_normal(linear.shape)
         holonomic = self.speed_factors[:, None] * linear * noise
         sagittas = np.zeros(self.robot_count)
