@@ -156,7 +156,7 @@ def test_planner_node_killed(graph):
     assert graph.client.spin_until(lambda: graph.gap, 5)
     assert graph.gap[-1] >= 0.0
     graph.client.spin_until(lambda: False, 0.3)
-    assert np.linalg.norm(graph.positions() - GOAL, axis=1).max() <= 0.02
+    assert np.linalg.norm(graph.positions() - GOAL, axis=1).max() <= 0.02, graph.logs()
     for name in ('fleet_sim', 'plan_executor'):
         graph.processes[name].assert_running()
 

@@ -22,10 +22,11 @@ corners ahead; a robot facing too far from where its reference goes turns in
 place while its reference stands still. After the end each parks its centre on
 its last position, then turns in place to its last orientation (``final_heading``).
 
-The execution is finished once s reached the plan's end and every robot is
-within ``goal_tolerance`` of its last configuration (and every differential
-robot has been within unicycle.HEADING_TOLERANCE of its final heading for
-unicycle.SETTLE seconds).
+The execution is finished once s reached the plan's end and every robot has
+been within ``goal_tolerance`` of its last configuration (and every
+differential robot within unicycle.HEADING_TOLERANCE of its final heading)
+for SETTLE seconds: a robot late behind the clock reaches its goal at speed,
+and one control step inside the tolerance would stop it centimetres beyond.
 """
 
 from dataclasses import dataclass
@@ -39,6 +40,8 @@ from .tolerance import clock_rate
 
 # Longest step the clock takes at once (s): a stalled control loop does not jump ahead.
 MAX_STEP = 0.2
+# Seconds every robot must stay at its goal (and final heading) before the run is finished.
+SETTLE = 0.5
 # Largest feed-forward gain: a robot that achieves a quarter of its commands is not helped.
 MAX_FEEDFORWARD_GAIN = 4.0
 # Reference speed (m/s) below which a robot's lag says nothing about its feed-forward
@@ -123,7 +126,7 @@ class Execution:
         self.turning = np.zeros(reference.robot_count, dtype=bool)
         # robots driving backward: their lead point is e behind, their 'heading' theta + pi
         self.reverse = np.zeros(reference.robot_count, dtype=bool)
-        self.settled = 0.0     # seconds every final heading has been reached for
+        self.settled = 0.0     # seconds every robot has been at its goal for
         # (k,) what each robot's feed-forward is multiplied by: 1 until it lags (_feedforward)
         self.feedforward_gains = np.ones(reference.robot_count)
         self.rate = 0.0        # the clock's last rate
@@ -239,13 +242,13 @@ class Execution:
         return self.feedforward_gains[:, None] * feedforward
 
     def _settled(self, arrived: bool, angles: np.ndarray, dt: float) -> bool:
-        """Return whether every differential robot has faced its final heading for SETTLE s."""
-        if not (self.settings.final_heading and self.differential.any()):
-            return True
-        facing = np.abs(unicycle.wrap(self.final_yaws - angles))[self.differential]
-        self.settled = (self.settled + dt if arrived and np.all(
-            facing <= unicycle.HEADING_TOLERANCE) else 0.0)
-        return self.settled >= unicycle.SETTLE
+        """Return whether every robot has been at its goal (and final heading) for SETTLE s."""
+        facing = True
+        if self.settings.final_heading and self.differential.any():
+            facing = bool(np.all(np.abs(unicycle.wrap(self.final_yaws - angles))[
+                self.differential] <= unicycle.HEADING_TOLERANCE))
+        self.settled = self.settled + dt if arrived and facing else 0.0
+        return self.settled >= SETTLE
 
     def _update_turns(self, angles: np.ndarray, watched: np.ndarray) -> np.ndarray:
         """

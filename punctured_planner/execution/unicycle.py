@@ -48,10 +48,9 @@ CORNER_RATE = 0.1
 # Gain (1/s) of the turns in place, on the heading error: its braking, 4 x 1.9 rad/s^2,
 # stays within a TurtleBot's yaw acceleration, and 4 x 200 ms latency does not ring.
 HEADING_GAIN = 4.0
-# A final heading within this (rad) of the requested one for SETTLE seconds is reached:
-# a late robot may still be turning when it passes the requested heading.
+# A final heading within this (rad) of the requested one for execution.SETTLE seconds is
+# reached: a late robot may still be turning when it passes the requested heading.
 HEADING_TOLERANCE = 0.02
-SETTLE = 0.5
 # Reference speeds below this (m/s) count as standing still.
 STILL = 1e-9
 
