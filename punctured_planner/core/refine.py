@@ -48,9 +48,10 @@ KNOTS = 64
 # needs O(KNOTS^2)), each knot's total move in the block clipped to its caps. Fresh caps
 # let robots use the room they made, so more blocks shorten more; but a block's caps
 # follow the motion (a pillar cap moves by up to half of what the motion moves), so
-# each block can amplify a change of input, and BLOCKS bounds that (measured: a 1e-7
-# change moves the refined motion 3 - 34x that, the construction's 2 - 6x).
-BLOCKS, SWEEPS = 12, 6
+# each block can amplify a change of input, and BLOCKS bounds that: on two point robots in
+# R^3 among one pillar a 1e-7 change moved the refined motion 7610x that with 12 blocks,
+# 153x with 10, 25 - 105x with 8, 5 - 6x with 6 (doc/design.md section 14).
+BLOCKS, SWEEPS = 6, 6
 # A block's cost grows like k^2 (all pairs near each other somewhere): beyond FULL_ROBOTS
 # robots the blocks fall as FULL_ROBOTS / k, and beyond MAX_ROBOTS none is run (the
 # construction's plan is returned; k is fixed on a domain, so this keeps continuity).
