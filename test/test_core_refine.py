@@ -26,6 +26,8 @@ VARIANTS = st.sampled_from(['paper', 'spread', 'discs'])
 RADII = st.sampled_from([0.0, 0.05])
 # The issue's continuity target: motion change / input change inside a domain.
 CONTINUITY = 100.0
+# The change of input the continuity tests make, per coordinate.
+NUDGE = 1e-7
 
 
 def workspace_for(obstacles, variant, radius):
@@ -33,6 +35,12 @@ def workspace_for(obstacles, variant, radius):
     radius = radius if variant == 'discs' else 0.0
     return Workspace(obstacles, dimension=obstacles.shape[1], variant=variant,
                      robot_radius=radius, obstacle_radius=radius)
+
+
+def nudged(configurations, seed):
+    """Return configurations with every coordinate moved by at most NUDGE, from seed."""
+    return configurations + np.random.default_rng(seed).uniform(-NUDGE, NUDGE,
+                                                                configurations.shape)
 
 
 def refined(workspace, configurations):
@@ -88,14 +96,12 @@ def test_a_small_change_inside_a_domain_moves_the_refined_motion_little(request,
     obstacles, configurations, _ = request
     assume(np.all(np.abs(configurations) < 1e3))
     workspace = workspace_for(obstacles, variant, radius)
-    size = 1e-7
-    moved = configurations + np.random.default_rng(seed).uniform(-size, size,
-                                                                 configurations.shape)
+    moved = nudged(configurations, seed)
     before, after = refined(workspace, configurations), refined(workspace, moved)
     assume(np.array_equal(before.projection_counts, after.projection_counts))
     tau = np.linspace(0.0, 1.0, 3001)
     change = np.abs(before.position(tau) - after.position(tau)).max()
-    assert change <= CONTINUITY * size, change / size
+    assert change <= CONTINUITY * NUDGE, change / NUDGE
 
 
 def test_the_refined_motion_is_shorter_and_its_stamps_work():
@@ -195,15 +201,13 @@ def test_with_walls_a_small_change_inside_a_domain_moves_the_refined_motion_litt
     Continuity with walls (half the request's side beyond it): a 1e-7 change, <= 100x.
 
     Or at most twice what the same change does without walls: the refinement's
-    own figure, which the test without walls bounds (it is above 100x on a few
-    inputs, e.g. four collinear point robots in R^4: up to 114x).
+    own figure, which the test without walls bounds (with 12 blocks it went above
+    100x on a few inputs, e.g. four collinear point robots in R^4: up to 114x).
     """
     obstacles, configurations, _ = request
     assume(np.all(np.abs(configurations) < 1e3))
     workspace = workspace_for(obstacles, variant, radius)
-    size = 1e-7
-    moved = configurations + np.random.default_rng(seed).uniform(-size, size,
-                                                                 configurations.shape)
+    moved = nudged(configurations, seed)
     try:
         before = plan(workspace, configurations, certify=False, refine=False)
         after = plan(workspace, moved, certify=False, refine=False)
@@ -227,7 +231,7 @@ def test_with_walls_a_small_change_inside_a_domain_moves_the_refined_motion_litt
         return np.abs(at(first) - at(second)).max()
 
     with_walls = change(bounds)
-    assert with_walls <= max(CONTINUITY * size, 2.0 * change(None)), with_walls / size
+    assert with_walls <= max(CONTINUITY * NUDGE, 2.0 * change(None)), with_walls / NUDGE
 
 
 def test_a_plan_inside_its_walls_is_returned_and_one_outside_refused():
