@@ -61,10 +61,15 @@ def pose_array_positions(msg):
                     dtype=float).reshape(-1, 3)
 
 
-def pose_array_orientations(msg):
-    """Return the orientations of a PoseArray as a (k, 4) array of (x, y, z, w)."""
-    return np.array([(p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w)
-                     for p in msg.poses], dtype=float).reshape(-1, 4)
+def pose_array_poses(msg):
+    """Return (positions (k, 3), orientations (k, 4): x, y, z, w) of a PoseArray, in one pass."""
+    rows = []
+    for p in msg.poses:
+        position, orientation = p.position, p.orientation
+        rows.append((position.x, position.y, position.z,
+                     orientation.x, orientation.y, orientation.z, orientation.w))
+    values = np.array(rows, dtype=float).reshape(-1, 7)
+    return values[:, :3], values[:, 3:]
 
 
 def odometry_pose(msg):
