@@ -193,7 +193,9 @@ def check(gathered: Gathered, snapshot: Snapshot) -> Checked:
     if state is not None:
         planned = _without_repeats(settings, positions, state)
     dropped = [m - 1 for m in range(1, len(positions)) if m not in planned]
-    return Checked(positions[planned], orientations[planned], planned, dropped)
+    if dropped:
+        positions, orientations = positions[planned], orientations[planned]
+    return Checked(positions, orientations, planned, dropped)
 
 
 def _check_range(settings: PlannerSettings, arrays: list[np.ndarray]) -> None:
