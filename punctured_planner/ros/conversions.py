@@ -228,17 +228,19 @@ def plan_to_paths(samples, orientations, frame_id, start_ns, plane_z=0.0):
     the stamp of the first pose. samples is ``plan.sample(samples_per_leg,
     max_speed)``: no pose twice, C_m exactly at ``samples.waypoints[m]``.
     Built once, for the response and the topics alike: a :class:`Paths` of the
-    messages (all paths share one Header object per stamp, so their stamps are
-    identical by construction, and each robot one Quaternion per waypoint; each
-    message is filled in place as by :func:`_filled`, with no default
-    sub-messages, its slots set one by one: a keyword loop per pose cost as much
-    as the rest) and the same values serialised with numpy on first use.
+    messages (all paths share one Header object per stamp, and one as their own
+    header, so their stamps are identical by construction, and each robot one
+    Quaternion per waypoint; each message is filled in place as by
+    :func:`_filled`, with no default sub-messages, its slots set one by one: a
+    keyword loop per pose cost as much as the rest) and the same values
+    serialised with numpy on first use.
     """
     xyz = to_xyz(samples.positions, plane_z).transpose(1, 0, 2)
     quaternions = normalized_quaternions(orientations).transpose(1, 0, 2)
     stamps = stamps_ns(start_ns, samples.values)
     waypoint = samples.last_waypoint()
     headers = [header(frame_id, stamp) for stamp in stamps.tolist()]
+    path_header = header(frame_id, start_ns)
     held_at = waypoint.tolist()
     new = object.__new__
     paths = []
@@ -259,7 +261,7 @@ def plan_to_paths(samples, orientations, frame_id, start_ns, plane_z=0.0):
             stamped = new(PoseStamped)
             stamped._header, stamped._pose, stamped._check_fields = pose_header, pose, False
             poses.append(stamped)
-        paths.append(_filled(Path, header=header(frame_id, start_ns), poses=poses))
+        paths.append(_filled(Path, header=path_header, poses=poses))
     return Paths(paths, frame_id, start_ns, stamps,
                  np.concatenate([xyz, quaternions[:, waypoint]], axis=-1))
 
