@@ -12,7 +12,11 @@ The floor, measured in the same run: an echo server in a process of its own
 requests over the same DDS with prebuilt responses of the same size (the
 offline plan of each request, built before serving). Its round trip is what rclpy
 and DDS cost alone: the request taken and converted, the response converted,
-serialised, sent, deserialised here. Calls to the two alternate.
+serialised, sent, deserialised here. Calls to the two alternate, and each call to
+the echo server waits until the node's publications of the plan before it are out
+(its Plan message, published last, has arrived here): the node publishes after its
+reply, and a floor timed while the node publishes beside it on a 2-core machine is
+slowed by it (README: at load 2-3 it was half as long again).
 
     .venv/bin/python bench/service_roundtrip.py                 # k = 8, n = 3
     .venv/bin/python bench/service_roundtrip.py -k 8 512 --refine false  # transport only
@@ -111,21 +115,33 @@ def timed_call(executor, client, request):
     return seconds, response
 
 
-def measure(executor, client, echo, k, n, calls, seed=1):
+def wait_published(executor, published, plan_id, timeout_sec=60.0):
+    """Spin until the node's Plan plan_id has arrived (published last: all its topics are out)."""
+    deadline = time.monotonic() + timeout_sec
+    while plan_id not in published:
+        if time.monotonic() > deadline:
+            raise RuntimeError('plan %d not published within %g s' % (plan_id, timeout_sec))
+        executor.spin_once(timeout_sec=0.01)
+
+
+def measure(executor, client, echo, published, k, n, calls, seed=1):
     """
     Return (round trips s, floor round trips s, planning times s, response bytes).
 
-    Each request goes to the node, then to the echo server (alternating).
+    Each request goes to the node, then, once the node has published that plan
+    (``published``: the plan ids seen on its ``plan`` topic), to the echo server.
     """
     from rclpy.serialization import serialize_message
     requests = requests_for(k, n, calls, seed)
     for request in requests[:2]:  # warm-up: publishers for these robot names, caches
-        timed_call(executor, client, request)
+        _, response = timed_call(executor, client, request)
+        wait_published(executor, published, response.plan_id)
         timed_call(executor, echo, request)
     trips, floor, planning = [], [], []
     for request in requests[2:]:
         seconds, response = timed_call(executor, client, request)
         trips.append(seconds)
+        wait_published(executor, published, response.plan_id)
         planning.append(response.planning_time.sec + response.planning_time.nanosec * 1e-9)
         seconds, echoed = timed_call(executor, echo, request)
         floor.append(seconds)
@@ -155,7 +171,16 @@ def main(argv=None):
     parameters = {'obstacles': '[%s]' % ','.join(str(v) for v in OBSTACLES),
                   'max_poses': MAX_POSES, 'refine': args.refine}
     with planner_session('bench', parameters) as session:
+        from punctured_planner.ros.qos import LATCHED
+        from punctured_planner_interfaces.msg import Plan
         from punctured_planner_interfaces.srv import PlanSequence
+        published = set()
+        # Raw: the plan id is the first field (uint64 after the CDR header), and the
+        # Plan is never deserialised here (k x M poses of Python objects at large k).
+        session.node.create_subscription(
+            Plan, session.namespace + '/plan',
+            lambda data: published.add(int.from_bytes(data[4:12], 'little')), LATCHED,
+            raw=True)
         echo_process = subprocess.Popen(
             [sys.executable, __file__, '--echo-server', '-n', str(args.n)]
             + (['--calls', str(args.calls)] if args.calls else [])
@@ -184,8 +209,8 @@ def main(argv=None):
                      'planning ms', 'bytes'))
             for k in ks:
                 calls = args.calls or calls_for(k)
-                trips, floor, planning, size = measure(session.executor, client, echo, k,
-                                                       args.n, calls)
+                trips, floor, planning, size = measure(session.executor, client, echo,
+                                                       published, k, args.n, calls)
                 print('%6d %6d %10.3f %10.3f %10.3f %10.2f %12.3f %12d' % (
                     k, calls, np.median(trips) * 1e3, np.percentile(trips, 90) * 1e3,
                     np.median(floor) * 1e3, np.median(trips) / np.median(floor),

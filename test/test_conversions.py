@@ -35,7 +35,10 @@ def test_quaternions_are_normalised_or_identity():
 def test_message_arrays_round_trip():
     msg = pose_array(CONFIGURATIONS[1], orientations=[YAW_90] * 4)
     assert np.array_equal(conversions.pose_array_positions(msg), CONFIGURATIONS[1])
-    assert np.array_equal(conversions.pose_array_orientations(msg), [YAW_90] * 4)
+    positions, orientations = conversions.pose_array_poses(msg)
+    assert np.array_equal(positions, CONFIGURATIONS[1])
+    assert np.array_equal(orientations, [YAW_90] * 4)
+    assert [a.shape for a in conversions.pose_array_poses(pose_array([]))] == [(0, 3), (0, 4)]
     assert conversions.pose_array_positions(pose_array([])).shape == (0, 3)
     assert conversions.obstacles_from_parameter([]).shape == (0, 3)
     assert np.array_equal(conversions.to_xyz(np.ones((2, 2)), 1.5), [[1, 1, 1.5]] * 2)

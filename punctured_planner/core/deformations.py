@@ -80,24 +80,31 @@ def spread(projections: np.ndarray, sorted_obstacle_projections: np.ndarray,
     n, k = projections.shape
     bounds = np.concatenate([[-np.inf], sorted_obstacle_projections, [np.inf]])
     interval = np.searchsorted(sorted_obstacle_projections, projections)
-    lower, upper = bounds[interval], bounds[interval + 1]
     # One group per (configuration, interval); robots sorted inside each group.
     group = np.arange(n)[:, None] * bounds.size + interval
-    order = np.lexsort((projections.ravel(), group.ravel()))
+    flat = projections.ravel()
+    order = np.lexsort((flat, group.ravel()))
     group_sorted = group.ravel()[order]
-    starts = np.flatnonzero(np.r_[True, np.diff(group_sorted) != 0])
-    sizes = np.diff(np.r_[starts, group_sorted.size])
-    rank = np.arange(group_sorted.size) - np.repeat(starts, sizes)
-    count = np.repeat(sizes, sizes)
-    low, high = lower.ravel()[order], upper.ravel()[order]
+    size = group_sorted.size
+    first = np.empty(size, dtype=bool)  # whether each sorted robot starts its group
+    first[0] = True
+    np.not_equal(group_sorted[1:], group_sorted[:-1], out=first[1:])
+    starts = np.flatnonzero(first)
+    member = np.cumsum(first) - 1  # the group of each sorted robot
+    sizes = np.diff(starts, append=size)
+    rank = np.arange(size) - starts[member]
+    count = sizes[member]
+    interval_sorted = interval.ravel()[order]
+    low, high = bounds[interval_sorted], bounds[interval_sorted + 1]
     spacing = _interval_spacing(high - low, count, min_spacing)
-    z = projections.ravel()[order] - (rank + 1) * spacing
+    z = flat[order] - (rank + 1) * spacing
     # Only groups whose shifted positions are out of order need a fit: an
-    # ordered z is its own isotonic regression.
-    descending = np.flatnonzero(np.diff(z) < 0)
-    disordered = np.unique(np.searchsorted(starts, descending, side='right') - 1)
-    for start, size in zip(starts[disordered], sizes[disordered]):
-        block = slice(start, start + size)
+    # ordered z is its own isotonic regression (up to the rounding of pooled
+    # ties). A descent across two groups marks the first of them.
+    disordered = np.zeros(starts.size, dtype=bool)
+    disordered[member[:-1][z[1:] < z[:-1]]] = True
+    for start, block_size in zip(starts[disordered].tolist(), sizes[disordered].tolist()):
+        block = slice(start, start + block_size)
         z[block] = isotonic_fit(z[block])
     z = np.clip(z, low, high - (count + 1) * spacing)
     result = np.empty(n * k)

@@ -90,6 +90,7 @@ class Plan:
         self._spacing = spacing
         self.raw = raw
         self.margin = margin
+        self._stamps: dict[tuple[float, float], np.ndarray] = {}
 
     @classmethod
     def axis(cls, workspace: Workspace, configurations: np.ndarray, positions: np.ndarray,
@@ -248,11 +249,19 @@ class Plan:
         Return (V,) seconds from the start at each breakpoint, fastest robot at max_speed.
 
         max_acceleration 0 (unlimited): each leg at max_speed throughout; else the
-        profile's stamps, at rest at both ends and slowed into the corners.
+        profile's stamps, at rest at both ends and slowed into the corners. Computed
+        once per pair of limits and kept, read-only: an answer takes the duration and
+        then the samples from the same stamps.
         """
-        # the gap only matters to the corners of a limited profile: no certificate for 0
-        return timed_stamps(self.positions, max_speed, max_acceleration,
-                            self.min_gap if max_acceleration else 0.0)
+        key = (float(max_speed), float(max_acceleration))
+        found = self._stamps.get(key)
+        if found is None:
+            # the gap only matters to the corners of a limited profile: no certificate for 0
+            found = timed_stamps(self.positions, max_speed, max_acceleration,
+                                 self.min_gap if max_acceleration else 0.0)
+            found.flags.writeable = False
+            self._stamps[key] = found
+        return found
 
     def duration(self, max_speed: float, max_acceleration: float = 0.0) -> float:
         """Return the duration in seconds of the whole motion under both limits."""

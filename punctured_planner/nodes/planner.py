@@ -179,8 +179,8 @@ class PlannerNode(Node):
         self.get_logger().debug('obstacles: %s' % obstacles.describe())
 
     def _on_robot_states(self, msg):
-        state = RobotState(conversions.pose_array_positions(msg),
-                           conversions.pose_array_orientations(msg), msg.header.frame_id,
+        positions, orientations = conversions.pose_array_poses(msg)
+        state = RobotState(positions, orientations, msg.header.frame_id,
                            conversions.stamp_to_ns(msg.header.stamp), 'robot_states',
                            self.get_clock().now().nanoseconds)
         with self._lock:

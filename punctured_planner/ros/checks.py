@@ -175,14 +175,13 @@ def check(gathered: Gathered, snapshot: Snapshot) -> Checked:
     """Step 2: convert the poses; the range, count, finiteness, frame and plane checks."""
     settings, obstacles, state = snapshot.settings, snapshot.obstacles, gathered.state
     states = [state] if state is not None else []
-    arrays = [s.positions for s in states] + [
-        conversions.pose_array_positions(c) for c in gathered.configurations]
+    poses = [conversions.pose_array_poses(c) for c in gathered.configurations]
+    arrays = [s.positions for s in states] + [p[0] for p in poses]
     _check_range(settings, arrays)
     check_obstacle_range(settings, obstacles)
     _check_counts(settings, gathered)
     positions = np.stack(arrays)
-    orientations = np.stack([s.orientations for s in states] + [
-        conversions.pose_array_orientations(c) for c in gathered.configurations])
+    orientations = np.stack([s.orientations for s in states] + [p[1] for p in poses])
     frames = [s.frame_id for s in states] + [c.header.frame_id for c in gathered.configurations]
     _check_non_finite(positions)
     check_obstacle_values(obstacles)
@@ -194,7 +193,9 @@ def check(gathered: Gathered, snapshot: Snapshot) -> Checked:
     if state is not None:
         planned = _without_repeats(settings, positions, state)
     dropped = [m - 1 for m in range(1, len(positions)) if m not in planned]
-    return Checked(positions[planned], orientations[planned], planned, dropped)
+    if dropped:
+        positions, orientations = positions[planned], orientations[planned]
+    return Checked(positions, orientations, planned, dropped)
 
 
 def _check_range(settings: PlannerSettings, arrays: list[np.ndarray]) -> None:

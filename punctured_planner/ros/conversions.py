@@ -26,6 +26,8 @@ Conventions:
   as the identity; others are normalised.
 """
 
+from functools import cached_property
+
 from builtin_interfaces.msg import Duration
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import Point
@@ -59,10 +61,20 @@ def pose_array_positions(msg):
                     dtype=float).reshape(-1, 3)
 
 
-def pose_array_orientations(msg):
-    """Return the orientations of a PoseArray as a (k, 4) array of (x, y, z, w)."""
-    return np.array([(p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w)
-                     for p in msg.poses], dtype=float).reshape(-1, 4)
+def pose_array_poses(msg):
+    """
+    Return (positions (k, 3), orientations (k, 4): x, y, z, w) of a PoseArray, in one pass.
+
+    Every request's poses come through here: the fields are read from their slots
+    (``_x`` for x, as :func:`_filled` writes them), half the time of their properties.
+    """
+    rows = []
+    for p in msg.poses:
+        position, orientation = p._position, p._orientation
+        rows.append((position._x, position._y, position._z,
+                     orientation._x, orientation._y, orientation._z, orientation._w))
+    values = np.array(rows, dtype=float).reshape(-1, 7)
+    return values[:, :3], values[:, 3:]
 
 
 def odometry_pose(msg):
@@ -97,7 +109,10 @@ def stamp_to_ns(stamp):
 
 def first_non_finite(values):
     """Return the index tuple of the first non-finite entry of an array, or None."""
-    bad = np.argwhere(~np.isfinite(values))
+    finite = np.isfinite(values)
+    if finite.all():  # the usual case: no search
+        return None
+    bad = np.argwhere(~finite)
     return tuple(int(i) for i in bad[0]) if bad.size else None
 
 
@@ -128,9 +143,16 @@ def normalized_quaternions(quaternions):
 # ---------------------------------------------------------------- time
 
 def time_from_ns(ns):
-    """Return builtin_interfaces/Time for integer nanoseconds (>= 0)."""
-    ns = int(ns)
-    return Time(sec=ns // 1000000000, nanosec=ns % 1000000000)
+    """
+    Return builtin_interfaces/Time for integer nanoseconds (>= 0).
+
+    Filled in place, as :func:`_filled` does but without its keyword loop: every
+    stamp of every path is one (Time's constructor costs five times as much).
+    """
+    stamp = object.__new__(Time)
+    stamp._sec, stamp._nanosec = divmod(int(ns), 1000000000)
+    stamp._check_fields = False
+    return stamp
 
 
 def duration_from_seconds(seconds):
@@ -180,9 +202,22 @@ def _filled(message_type, **fields):
 
 
 class Paths(list):
-    """The robots' nav_msgs/Paths, and ``serialized``: the same Paths as CDR bytes (topics)."""
+    """
+    The robots' nav_msgs/Paths, and ``serialized``: the same Paths as CDR bytes (topics).
 
-    serialized = ()
+    The bytes are built on first use: only the topics need them, and the node
+    publishes after the reply (msg_docs/topics.md), so the reply does not wait for them.
+    """
+
+    def __init__(self, paths, frame_id, start_ns, stamps, values):
+        """Keep the Paths and what their bytes are built from: stamps (M,), values (k, M, 7)."""
+        super().__init__(paths)
+        self._cdr = (frame_id, start_ns, stamps, values)
+
+    @cached_property
+    def serialized(self):
+        """Return each Path as CDR bytes (:func:`~punctured_planner.ros.cdr.serialized_paths`)."""
+        return serialized_paths(*self._cdr)
 
 
 def plan_to_paths(samples, orientations, frame_id, start_ns, plane_z=0.0):
@@ -193,45 +228,55 @@ def plan_to_paths(samples, orientations, frame_id, start_ns, plane_z=0.0):
     the stamp of the first pose. samples is ``plan.sample(samples_per_leg,
     max_speed)``: no pose twice, C_m exactly at ``samples.waypoints[m]``.
     Built once, for the response and the topics alike: a :class:`Paths` of the
-    messages (all paths share one Header object per stamp, so their stamps are
-    identical by construction, and each robot one Quaternion per waypoint; each
-    pose is filled in place by :func:`_filled`, with no default sub-messages)
-    and the same values serialised with numpy.
+    messages (all paths share one Header object per stamp, and one as their own
+    header, so their stamps are identical by construction, and each robot one
+    Quaternion per waypoint; each message is filled in place as by
+    :func:`_filled`, with no default sub-messages, its slots set one by one: a
+    keyword loop per pose cost as much as the rest) and the same values
+    serialised with numpy on first use.
     """
     xyz = to_xyz(samples.positions, plane_z).transpose(1, 0, 2)
     quaternions = normalized_quaternions(orientations).transpose(1, 0, 2)
     stamps = stamps_ns(start_ns, samples.values)
     waypoint = samples.last_waypoint()
     headers = [header(frame_id, stamp) for stamp in stamps.tolist()]
-    held = [[_filled(Quaternion, x=qx, y=qy, z=qz, w=qw) for qx, qy, qz, qw in robot]
-            for robot in quaternions.tolist()]
-    paths = Paths()
-    paths.serialized = serialized_paths(frame_id, start_ns, stamps, np.concatenate(
-        [xyz, quaternions[:, waypoint]], axis=-1))
+    path_header = header(frame_id, start_ns)
+    held_at = waypoint.tolist()
     new = object.__new__
-    for robot_xyz, robot_held in zip(xyz.tolist(), held):
+    paths = []
+    for robot_xyz, robot_quaternions in zip(xyz.tolist(), quaternions.tolist()):
+        held = []
+        for qx, qy, qz, qw in robot_quaternions:
+            quaternion = new(Quaternion)
+            quaternion._x, quaternion._y, quaternion._z, quaternion._w = qx, qy, qz, qw
+            quaternion._check_fields = False
+            held.append(quaternion)
         poses = []
-        for pose_header, (x, y, z), m in zip(headers, robot_xyz, waypoint.tolist()):
+        for pose_header, (x, y, z), m in zip(headers, robot_xyz, held_at):
             point = new(Point)
             point._x, point._y, point._z, point._check_fields = x, y, z, False
             pose = new(Pose)
-            pose._position, pose._orientation = point, robot_held[m]
+            pose._position, pose._orientation = point, held[m]
             pose._check_fields = False
             stamped = new(PoseStamped)
             stamped._header, stamped._pose, stamped._check_fields = pose_header, pose, False
             poses.append(stamped)
-        paths.append(_filled(Path, header=header(frame_id, start_ns), poses=poses))
-    return paths
+        paths.append(_filled(Path, header=path_header, poses=poses))
+    return Paths(paths, frame_id, start_ns, stamps,
+                 np.concatenate([xyz, quaternions[:, waypoint]], axis=-1))
 
 
 def header(frame_id, stamp_ns):
     """
     Return a std_msgs/Header in frame_id (a str) at integer nanoseconds.
 
-    Filled in place (:func:`_filled`): Header's constructor would first build a
-    default Time only to replace it, for every stamp of every path.
+    Filled in place (as :func:`time_from_ns`): Header's constructor would first
+    build a default Time only to replace it, for every stamp of every path.
     """
-    return _filled(Header, frame_id=frame_id, stamp=time_from_ns(stamp_ns))
+    message = object.__new__(Header)
+    message._frame_id, message._stamp = frame_id, time_from_ns(stamp_ns)
+    message._check_fields = False
+    return message
 
 
 def pose(position, orientation=IDENTITY):
