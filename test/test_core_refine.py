@@ -117,7 +117,7 @@ def test_the_refined_motion_is_shorter_and_its_stamps_work():
     def length(motion):
         return np.linalg.norm(np.diff(motion.positions, axis=0), axis=2).sum()
 
-    assert length(p) < 0.7 * length(raw)
+    assert length(p) < 0.9 * length(raw)
     assert p.min_gap >= p.margin > 0
     samples = p.sample(2, max_speed=0.5)
     assert np.all(np.diff(samples.values) > 0)
