@@ -37,14 +37,17 @@ The construction keeps the paper's skeleton, H(C_m), Gamma, H(C_{m+1})^-1
   s = T every robot is above every zone, unpushed: the fleet is C with every
   h_i replaced by F(h_i).
 * gather: every robot moves along e1 only, at its risen height, into the
-  column of slot rank(x) of the staging line at height top (the axis itself
-  when there are no pillars, and no rise) centred on the mean robot
-  projection; slots g = max(min_spacing, 2R + nu) apart along e1; rank orders
-  robots by projection, ties by index.
+  column of slot rank(x) (the hyperplane p = that slot); slots
+  g = max(min_spacing, 2R + nu) apart along e1, centred on the mean robot
+  projection; rank orders robots by projection, ties by index. A slot is its
+  column at height top (the axis' height when there are no pillars, and no
+  rise), the robot's coordinates across e1 and e2 kept (d >= 3): the staging
+  line in the plane, the staging hyperplane h = top in 3-D.
 * Gamma between base configurations (the paper's section, equation 3.1, with
-  shared lanes): every robot moves within its column to its lane top + l g on
-  the staging line (lane 0 is the staging line itself), slides to its next
-  slot and moves within that column to its next base position. Robots whose
+  shared lanes): every robot moves along e2 within its column to its lane
+  top + l g (lane 0 is the staging height itself), slides at that height to
+  its next slot's column (and its next coordinates across e1 and e2) and moves
+  along e2 within that column to its next base position. Robots whose
   slots keep their order share a lane (shared_lanes), so a segment needs as
   many lanes as its longest run of robots whose order reverses, not k.
 
@@ -119,9 +122,10 @@ smaller of its start and g, while the other coordinates stay: the pair keeps
 at least the smaller of its start distance and g >= 2R + nu. All of it lies
 in h >= top, where every robot is at least z_j >= w_j from every pillar.
 (4) Gamma. Each robot moves within its column (the hyperplane p = its slot,
-g >= 2R + nu from the next one) between heights >= top, then slides along e1
-in lanes g apart at heights >= top; two robots in one lane keep their order
-and slide linearly between slots g apart, so they stay g apart. The inverse
+g >= 2R + nu from the next one) between heights >= top, then slides in lanes
+g apart in e2 at heights >= top; two robots in one lane keep their order, so
+their e1 difference moves linearly between multiples of g: they stay g apart
+whatever their other coordinates do. The inverse
 legs are the same legs run backwards. Without pillars there is no rise and
 (3), (4) hold from C itself. QED.
 
@@ -263,15 +267,14 @@ def staging_ranks(p: np.ndarray) -> np.ndarray:
     return rank
 
 
-def staging_slots(p: np.ndarray, rank: np.ndarray, layout: DiscLayout) -> np.ndarray:
+def staging_slots(p: np.ndarray, rank: np.ndarray, pitch: float) -> np.ndarray:
     """
-    Return the (k, d) slots of the staging line for robots of projections p (k,).
+    Return the (k,) projections of the slots for robots of projections p (k,).
 
     Slot rank(x) lies (rank - (k - 1) / 2) g along e1 from the mean robot
-    projection, on the line at height top.
+    projection.
     """
-    along = p.mean() + (rank - (len(rank) - 1) / 2) * layout.pitch
-    return layout.frame.axis_points(along) + layout.top * layout.frame.e2
+    return p.mean() + (rank - (len(rank) - 1) / 2) * pitch
 
 
 def shared_lanes(first: np.ndarray, second: np.ndarray) -> np.ndarray:
@@ -315,7 +318,7 @@ def section(configurations: np.ndarray, layout: DiscLayout) -> DiscSection:
     breakpoints, exactly.
     """
     n, k, _ = configurations.shape
-    e2 = layout.frame.e2
+    e1, e2 = layout.frame.e1, layout.frame.e2
     deformations = []
     projections = layout.frame.project(configurations)
     offsets = layout.frame.offset(configurations)
@@ -323,9 +326,10 @@ def section(configurations: np.ndarray, layout: DiscLayout) -> DiscSection:
         risen = rise(p, h, layout).positions(configuration, layout.frame)
         names = [SIDESTEP] + [RISE] * (len(risen) - 2)
         rank = staging_ranks(p)
-        slots = staging_slots(p, rank, layout)
-        # The gather moves along e1 only, onto the slots' columns, at the risen heights.
-        columns = risen[-1] + (layout.frame.project(slots) - p)[:, None] * layout.frame.e1
+        # The gather moves along e1 only, into the slots' columns, at the risen heights; a
+        # slot is its column at height top, other coordinates (d >= 3) kept.
+        columns = risen[-1] + (staging_slots(p, rank, layout.pitch) - p)[:, None] * e1
+        slots = columns + (layout.top - layout.frame.offset(columns))[:, None] * e2
         deformations.append((risen, names, rank, slots, columns))
     stages, names, ends, heights = [configurations[0]], [''], [], set()
     for m in range(n - 1):
