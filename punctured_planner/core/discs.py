@@ -20,8 +20,9 @@ The construction keeps the paper's skeleton, H(C_m), Gamma, H(C_{m+1})^-1
 * sidestep and rise: robot i rises along e2 by min(s, s_i), s from 0 to
   T = max_i s_i, with its stop s_i = max(0, top + beta (h_i - h_min) - h_i),
   top = max_j (h(q_j) + z_j), h_min = min_i h(x_i) and the compression
-  beta = (1 + MARGIN) / 2: it ends at F(h_i) = max(h_i, top + beta (h_i - h_min)),
-  above every zone, so a robot high up rises little. Meanwhile each robot in
+  beta = (1 + MARGIN) / 2 (1 beyond COMPRESSED_ROBOTS robots): it ends at
+  F(h_i) = max(h_i, top + beta (h_i - h_min)), above every zone, so a robot
+  high up rises little. Meanwhile each robot in
   the shadow of pillar j (|p(x) - p(q_j)| < w_j) is pushed along e1, away from
   p(q_j) on its own side (a robot whose projection equals p(q_j) counts as
   right of it, as the paper's numbering puts robots after obstacles), by
@@ -153,6 +154,10 @@ MARGIN = 0.1
 # so two robots S = 4R apart end >= beta S = 2R + 2 nu apart: one nu more than the gather
 # needs (module docstring). Smaller beta rises less; 2R + nu / 4R is the least it may be.
 COMPRESSION = (1.0 + MARGIN) / 2
+# Every stop is a breakpoint of the whole motion: k more per rise. Beyond this many robots
+# (k is constant on a domain) the fleet rises as one (beta = 1, a single stop), which keeps
+# a plan of 200 robots within its time budget (doc/design.md section 6).
+COMPRESSED_ROBOTS = 64
 
 SIDESTEP, RISE, GATHER = 'sidestep', 'rise', 'gather'
 LIFT, SLIDE, DROP = 'lift', 'slide', 'drop'
@@ -240,7 +245,9 @@ def rise(p: np.ndarray, h: np.ndarray, layout: DiscLayout) -> Rise:
     if layout.reach.size == 0:
         return Rise(np.zeros((1, len(p))), np.zeros((1, len(p))))
     low = float(h.min())
-    stops = np.maximum(0.0, layout.top + COMPRESSION * (h - low) - h)
+    compression = COMPRESSION if len(h) <= COMPRESSED_ROBOTS else 1.0
+    # (top - h_min) - (1 - beta) (h_i - h_min): with beta = 1 every stop is the same float.
+    stops = np.maximum(0.0, (layout.top - low) - (1.0 - compression) * (h - low))
     total = float(stops.max())
     signed = p[:, None] - layout.pillar_projections[None, :]
     robots, pillars = np.nonzero(np.abs(signed) < layout.reach[None, :])
