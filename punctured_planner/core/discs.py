@@ -152,7 +152,8 @@ FULL, ZONE = np.sqrt(2.0) - 1.0, np.sqrt(2.0)
 MARGIN = 0.1
 # The rise's compression beta: robot i stops at F(h_i) = max(h_i, top + beta (h_i - h_min)),
 # so two robots S = 4R apart end >= beta S = 2R + 2 nu apart: one nu more than the gather
-# needs (module docstring). Smaller beta rises less; 2R + nu / 4R is the least it may be.
+# needs (module docstring). Smaller beta rises less; (2R + nu) / 4R = 0.525 is the least
+# it may be.
 COMPRESSION = (1.0 + MARGIN) / 2
 # Every stop is a breakpoint of the whole motion: k more per rise. Beyond this many robots
 # (k is constant on a domain) the fleet rises as one (beta = 1, a single stop), which keeps
@@ -342,7 +343,7 @@ def section(configurations: np.ndarray, layout: DiscLayout) -> DiscSection:
     for m in range(n - 1):
         risen, rise_names, rank, slots, columns = deformations[m]
         back, back_names, next_rank, next_slots, next_columns = deformations[m + 1]
-        # Lane 0 is the staging line itself.
+        # Lane 0 is the staging height itself: its robots need no lift.
         lift = shared_lanes(rank, next_rank) * layout.pitch
         heights.update((layout.top + lift).tolist())
         stages += [*risen[1:], columns, slots + lift[:, None] * e2,
