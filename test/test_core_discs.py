@@ -14,7 +14,7 @@ from core_strategies import lattice_requests, requests, separation
 from hypothesis import assume, given, HealthCheck, settings, strategies as st
 import numpy as np
 from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
-from punctured_planner.core.discs import MARGIN
+from punctured_planner.core.discs import COMPRESSED_ROBOTS, COMPRESSION, MARGIN, rise
 import pytest
 
 PROPERTY = settings(max_examples=120, deadline=None,
@@ -26,7 +26,7 @@ def keeps_margin(p):
     Return whether the certified gap is positive and min(nu, the input's pillar gaps).
 
     nu = R / 10 is reached exactly where the construction is tight (a pass at
-    exactly mu_j = nu, a gather at exactly S), so it is met up to the rounding
+    exactly mu_j = nu, a gather at exactly nu), so it is met up to the rounding
     of the coordinates; that far from 0 no rounding can refuse the plan. A
     robot that touches a pillar in a configuration keeps that gap of its input.
     """
@@ -204,3 +204,24 @@ def test_bad_radii_are_refused(options, words):
         Workspace([[0.0, 0.0], [1.0, 0.0]], variant='discs', **options)
     assert caught.value.code == ErrorCode.INVALID_REQUEST
     assert words in str(caught.value)
+
+
+@pytest.mark.parametrize('count', [9, COMPRESSED_ROBOTS, COMPRESSED_ROBOTS + 1])
+def test_the_rise_ends_every_robot_at_its_compressed_height_unpushed(count):
+    """F(h) = max(h, top + beta (h - h_min)), beta = 1 beyond COMPRESSED_ROBOTS robots."""
+    pillars = np.array([[0.0, 0.0], [2.5, 1.0], [5.0, -0.5]])
+    layout = Workspace(pillars, variant='discs', robot_radius=0.2,
+                       obstacle_radius=0.15).disc_layout
+    p = np.linspace(-1.0, 6.0, count)
+    h = np.random.default_rng(count).uniform(-4.0, 6.0, count)
+    h[0], h[-1] = layout.top + 15.0, -4.0  # one robot far above top, one below all
+    motion = rise(p, h, layout)
+    beta = COMPRESSION if count <= COMPRESSED_ROBOTS else 1.0
+    expected = np.maximum(h, layout.top + beta * (h - h.min()))
+    assert np.allclose(h + motion.lift[-1], expected, rtol=0, atol=1e-12)
+    assert np.all(motion.shift[-1] == 0)
+    assert np.all(np.diff(motion.lift, axis=0) >= 0)  # no robot ever moves down
+    if beta == 1.0:  # the fleet rises as one: the rise adds no breakpoint per robot
+        assert np.all(motion.lift == motion.lift[:, :1])
+    else:  # the robot far above top does not move, the lowest rises to top exactly
+        assert np.all(motion.lift[:, 0] == 0) and h[-1] + motion.lift[-1, -1] == layout.top

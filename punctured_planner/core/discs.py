@@ -17,41 +17,50 @@ is a gap >= c between the real ones.
 The construction keeps the paper's skeleton, H(C_m), Gamma, H(C_{m+1})^-1
 (Remark 2.3), with a new deformation H onto a new kind of base configuration:
 
-* sidestep and rise: the whole fleet translates along e2 by
-  T(C) = max(0, top - min_i h(x_i)), top = max_j (h(q_j) + z_j), while each
-  robot in the shadow of pillar j (|p(x) - p(q_j)| < w_j) is pushed along e1,
-  away from p(q_j) on its own side (a robot whose projection equals p(q_j)
-  counts as right of it, as the paper's numbering puts robots after
-  obstacles), by lambda_j(u) (w_j - |p(x) - p(q_j)|). Here u = h(x) + s - h(q_j)
-  is the robot's height relative to the pillar after rising by s, and
-  lambda_j(u) = clip((z_j - |u|) / (z_j - f_j), 0, 1) with f_j = (sqrt 2 - 1) w_j
-  and z_j = sqrt 2 w_j: w_j lambda_j(u) is the half octagon circumscribing the
-  circle of radius w_j, so w_j lambda_j(u) >= sqrt(w_j^2 - u^2) for |u| <= w_j.
-  Pushes of several pillars add up. Each robot's e1 offset is then piecewise
-  linear in s with kinks only where u crosses +-f_j and +-z_j, so the
+* sidestep and rise: robot i rises along e2 by min(s, s_i), s from 0 to
+  T = max_i s_i, with its stop s_i = max(0, top + beta (h_i - h_min) - h_i),
+  top = max_j (h(q_j) + z_j), h_min = min_i h(x_i) and the compression
+  beta = (1 + MARGIN) / 2 (1 beyond COMPRESSED_ROBOTS robots): it ends at
+  F(h_i) = max(h_i, top + beta (h_i - h_min)), above every zone, so a robot
+  high up rises little. Meanwhile each robot in
+  the shadow of pillar j (|p(x) - p(q_j)| < w_j) is pushed along e1, away from
+  p(q_j) on its own side (a robot whose projection equals p(q_j) counts as
+  right of it, as the paper's numbering puts robots after obstacles), by
+  lambda_j(u) (w_j - |p(x) - p(q_j)|). Here u is the robot's height relative to
+  the pillar and lambda_j(u) = clip((z_j - |u|) / (z_j - f_j), 0, 1) with
+  f_j = (sqrt 2 - 1) w_j and z_j = sqrt 2 w_j: w_j lambda_j(u) is the half
+  octagon circumscribing the circle of radius w_j, so
+  w_j lambda_j(u) >= sqrt(w_j^2 - u^2) for |u| <= w_j. Pushes of several
+  pillars add up. Each robot's offsets are then piecewise linear in s with
+  kinks only where u crosses +-f_j and +-z_j and at the stops, so the
   breakpoints of all robots together describe the motion exactly. A push
   already due at s = 0 is made first, along e1 only (the sidestep leg). At
-  s = T every robot is above every zone, so the fleet ends as C + T e2.
-* gather (CAPT's synchronised straight lines, Turpin, Michael & Kumar): every
-  robot moves on a straight line to slot rank(x) of the staging line at height
-  top (the axis itself when there are no pillars) centred on the mean robot
-  projection, slots g = max(min_spacing, g_R) apart along e1, g_R = 2aS / sqrt(S^2 - 4a^2)
-  for a = R + nu / 2 and S = 4R (about 2.47R, where 4R / sqrt 3 would keep 2R only); rank
-  orders robots by projection, ties by index.
-* Gamma between staging lines (the paper's section, equation 3.1, with shared
-  lanes): every robot lifts to its lane top + (l + 1) c, c = max(lane_spacing,
-  2R + nu), slides to its next slot and drops. Robots whose slots keep their order
-  share a lane (shared_lanes), so a segment needs as many lanes as its longest
-  run of robots whose order reverses, not k.
+  s = T every robot is above every zone, unpushed: the fleet is C with every
+  h_i replaced by F(h_i).
+* gather: every robot moves along e1 only, at its risen height, into the
+  column of slot rank(x) (the hyperplane p = that slot); slots
+  g = max(min_spacing, 2R + nu) apart along e1, centred on the mean robot
+  projection; rank orders robots by projection, ties by index. A slot is its
+  column at height top (the axis' height when there are no pillars, and no
+  rise), the robot's coordinates across e1 and e2 kept (d >= 3): the staging
+  line in the plane, the staging hyperplane h = top in 3-D.
+* Gamma between base configurations (the paper's section, equation 3.1, with
+  shared lanes): every robot moves along e2 within its column to its lane
+  top + l g (lane 0 is the staging height itself), slides at that height to
+  its next slot's column (and its next coordinates across e1 and e2) and moves
+  along e2 within that column to its next base position. Robots whose
+  slots keep their order share a lane (shared_lanes), so a segment needs as
+  many lanes as its longest run of robots whose order reverses, not k.
 
 Continuity and domains. On a stratum A_i the order of all k + r projections,
 ties included, is locally constant, so the side of every push and the ranks
-are; T, the pushes (continuous in p, h and zero at the shadow's edge), the
-slot centre and every breakpoint move continuously. The motion is therefore
-continuous on every A_{j_1} x ... x A_{j_n}, hence on every domain of the
-paper, whose projection counts, domains and TC_n it shares. Breakpoints that
-appear as a robot enters a shadow carry a push of size 0 and split legs along
-which every robot moves linearly, so they do not change the motion.
+are; the stops and F (continuous in h), the pushes (continuous in p, h and
+zero at the shadow's edge), the slot centre and every breakpoint move
+continuously. The motion is therefore continuous on every A_{j_1} x ... x
+A_{j_n}, hence on every domain of the paper, whose projection counts, domains
+and TC_n it shares. Breakpoints that appear as a robot enters a shadow carry
+a push of size 0, and two stops that cross split a leg along which every
+robot moves linearly, so they do not change the motion.
 
 Theorem (bodies keep a margin). Let S = max(4R, 2R + nu + max_j w_j), which
 is 4R when every rho_j <= 0.8R. Suppose in every configuration (a) robot
@@ -65,10 +74,14 @@ robot-pillar gap of the configurations themselves (a robot touching a pillar
 in C_m keeps that gap there), a margin far above the rounding of the
 coordinates unless the input itself touches.
 
-Proof. Every leg is one of the following.
-(1) Sidestep and rise, robot and pillar j. While |u| > w_j the e2 distance
-exceeds w_j. While |u| <= w_j, the push of j alone puts the robot at e1
-offset delta + lambda_j (w_j - delta) >= lambda_j w_j >= sqrt(w_j^2 - u^2)
+Proof. F(y) - F(x) lies in [beta (y - x), y - x] for x <= y (a maximum of
+functions of slopes 1 and beta), and a higher robot stops no later, so
+during the rise the e2 difference of two robots keeps its sign and at least
+beta of its size. Every leg is one of the following.
+(1) Sidestep and rise, robot and pillar j. Each robot follows the path of a
+common rise, cut off at its stop above every zone. While |u| > w_j the e2
+distance exceeds w_j. While |u| <= w_j, the push of j alone puts the robot at
+e1 offset delta + lambda_j (w_j - delta) >= lambda_j w_j >= sqrt(w_j^2 - u^2)
 from p(q_j), so at distance >= w_j (gap >= mu_j); the sidestep moves a robot
 straight away from p(q_j), so its gap only grows from C's. Pushes of pillars on the
 same side only add to it. A pillar l on the other side pushes only while the
@@ -77,30 +90,45 @@ p(q_j) in e1 and within w_j + z_l of h(q_j) in e2, excluded by (c). A robot
 pushed towards a pillar l whose shadow it was not in reaches it only if
 |p(q_j) - p(q_l)| < w_j + w_l, and then by (c) it is more than z_l + 2R + nu
 from h(q_l) in e2.
-(2) Sidestep and rise, two robots. Their e2 and other coordinates change by
-the same s, so if those differ by at least 2R + nu the gap stays >= nu.
-Otherwise their e1 distance is at least sqrt(S^2 - (2R + nu)^2) > max w_j,
-so they are not in one shadow on one side, and by (c) no robot is pushed by
-two pillars at once (their shadows and zones would overlap). If both are
-pushed towards each other, by j and l, their zones overlap within 2R + nu in
-e2, so by (c) p(q_l) - p(q_j) >= w_j + w_l + 2R + nu while they stay within
-w_j of p(q_j) and w_l of p(q_l): 2R + nu apart in e1. Otherwise at most one
-moves towards the other, by at most w_max = max_j w_j in e1, and
-(|dp| - w_max)^2 + dh^2 = S^2 - 2 w_max sqrt(S^2 - dh^2) + w_max^2 grows with
-dh, so it is at least (S - w_max)^2 >= (2R + nu)^2 whenever |dp|^2 + dh^2 >= S^2.
-(3) Gather. It starts from C + T e2 (pairwise >= S) and ends on slots >= g
-apart along e1 in projection order. For robots a, b with rank a < rank b the
-start difference P = x_b - x_a has P.e1 >= 0 and the end difference Q is a
-positive multiple of e1, so P.Q >= 0 and |(1 - t) P + t Q|^2 >=
-(1 - t)^2 S^2 + t^2 g^2 >= S^2 g^2 / (S^2 + g^2) >= (2R + nu)^2 for
-g >= 2aS / sqrt(S^2 - 4a^2), a = R + nu / 2, a bound that decreases in S, so
-g_R (taken at S = 4R) serves every S >= 4R. The start, the slots and so the
-straight lines lie in the half-space h >= top, where every robot is at least
-z_j >= w_j from every pillar.
-(4) Gamma. Lifts and drops are along e2 in columns g >= 2R + nu apart, slides
-along e1 in lanes c >= 2R + nu apart, all in h >= top; two robots in one lane
-keep their order and slide linearly between slots g apart, so they stay g
-apart. The inverse legs are the same legs run backwards. QED.
+(2) Sidestep and rise, two robots. (i) While both rise, their e2 and other
+coordinates change by the same s, so if those differ by at least 2R + nu the
+gap stays >= nu. Otherwise their e1 distance is at least
+sqrt(S^2 - (2R + nu)^2) > max w_j, so they are not in one shadow on one side,
+and by (c) no robot is pushed by two pillars at once (their shadows and zones
+would overlap). If both are pushed towards each other, by j and l, their
+zones overlap within 2R + nu in e2, so by (c) p(q_l) - p(q_j) >= w_j + w_l +
+2R + nu while they stay within w_j of p(q_j) and w_l of p(q_l): 2R + nu apart
+in e1. Otherwise at most one moves towards the other, by at most
+w_max = max_j w_j in e1, and (|dp| - w_max)^2 + dh^2 = S^2 - 2 w_max
+sqrt(S^2 - dh^2) + w_max^2 grows with dh, so it is at least
+(S - w_max)^2 >= (2R + nu)^2 whenever |dp|^2 + dh^2 >= S^2. (ii) While
+neither is pushed, only their e2 difference has changed, by the factor
+above: they are >= beta S = 2R + 2 nu apart. (iii) Otherwise one, a, is
+pushed by some j (so it still rises, below top) and b has stopped: then
+h_b > h_a, b is at F(h_b) >= top + beta (h_b - h_min) and a at
+eps = z_j - u <= top - h(a) below top, so their e2 distance is at least
+beta y + eps, y = h_b - h_a; a's push is lambda_j (w_j - delta) <=
+min(w_j, z_j - |u|) <= eps (z_j - f_j = w_j), so their distance across e2
+is at least x - eps, x = that distance in C. With x^2 + y^2 = rho^2 >= S^2
+the distance is at least the minimum over eps >= 0 of
+sqrt((x - eps)_+^2 + (beta y + eps)^2), which is (x + beta y) / sqrt 2 when
+x >= beta y and sqrt(x^2 + beta^2 y^2) >= beta rho otherwise; along the arc
+x + beta y is smallest at its ends, so the pair stays at least
+min(S / sqrt 2, beta S) >= 2R + 2 nu apart.
+(3) Gather. It starts from the risen fleet, pairwise >= beta S >= 2R + nu
+apart, and moves along e1 only to columns g apart in projection order. For
+robots a, b with rank a < rank b the e1 difference moves linearly from its
+start (>= 0) to a multiple of g, so at every instant it is at least the
+smaller of its start and g, while the other coordinates stay: the pair keeps
+at least the smaller of its start distance and g >= 2R + nu. All of it lies
+in h >= top, where every robot is at least z_j >= w_j from every pillar.
+(4) Gamma. Each robot moves within its column (the hyperplane p = its slot,
+g >= 2R + nu from the next one) between heights >= top, then slides in lanes
+g apart in e2 at heights >= top; two robots in one lane keep their order, so
+their e1 difference moves linearly between multiples of g: they stay g apart
+whatever their other coordinates do. The inverse
+legs are the same legs run backwards. Without pillars there is no rise and
+(3), (4) hold from C itself. QED.
 
 Outside the condition the plan is made all the same; the exact certificate
 (Plan.min_gap) says what it achieved and required_clearance refuses it.
@@ -122,9 +150,15 @@ FULL, ZONE = np.sqrt(2.0) - 1.0, np.sqrt(2.0)
 # The body margins as fractions: mu_j = MARGIN max(R, rho_j) past pillar j, nu = MARGIN R
 # between two robots (module docstring). Every body gap of the plan keeps one of them.
 MARGIN = 0.1
-# Slot spacing g / R for robots S >= 4R apart: the gather then keeps pairs 2R + nu apart
-# (g = 2 a S / sqrt(S^2 - 4 a^2) with a = R + nu / 2 and S = 4R; 4 / sqrt 3 keeps only 2R).
-_SLOT_FACTOR = 8.0 * (1.0 + MARGIN / 2) / np.sqrt(16.0 - 4.0 * (1.0 + MARGIN / 2) ** 2)
+# The rise's compression beta: robot i stops at F(h_i) = max(h_i, top + beta (h_i - h_min)),
+# so two robots S = 4R apart end >= beta S = 2R + 2 nu apart: one nu more than the gather
+# needs (module docstring). Smaller beta rises less; (2R + nu) / 4R = 0.525 is the least
+# it may be.
+COMPRESSION = (1.0 + MARGIN) / 2
+# Every stop is a breakpoint of the whole motion: k more per rise. Beyond this many robots
+# (k is constant on a domain) the fleet rises as one (beta = 1, a single stop), which keeps
+# a plan of 200 robots within its time budget (doc/design.md section 6).
+COMPRESSED_ROBOTS = 64
 
 SIDESTEP, RISE, GATHER = 'sidestep', 'rise', 'gather'
 LIFT, SLIDE, DROP = 'lift', 'slide', 'drop'
@@ -136,8 +170,8 @@ class DiscLayout:
     What the construction fixes per workspace: the pillars in frame coordinates and pitches.
 
     reach w_j, full-push and zone half-heights f_j, z_j per pillar, the staging
-    height top (0, the axis, without pillars), the slot spacing g and the lane
-    pitch c (module docstring).
+    height top (0, the axis, without pillars) and the pitch g of the slots and
+    the lanes (module docstring).
     """
 
     frame: Frame
@@ -147,13 +181,11 @@ class DiscLayout:
     full: np.ndarray
     zone: np.ndarray
     top: float
-    slot_spacing: float
-    lane_pitch: float
+    pitch: float
 
     @classmethod
     def from_radii(cls, frame: Frame, obstacles: np.ndarray, robot_radius: float,
-                   obstacle_radius: np.ndarray, lane_spacing: float,
-                   min_spacing: float) -> 'DiscLayout':
+                   obstacle_radius: np.ndarray, min_spacing: float) -> 'DiscLayout':
         """Return the layout for pillars (r, d) of radii (r,) and robots of radius R."""
         # A passing margin for every pillar size: mu_j = 0 (rho_j >= R, before) let bodies
         # graze. S stays 4R while w_j <= 1.9R (rho_j <= 0.8R); wider margins make
@@ -164,9 +196,7 @@ class DiscLayout:
         offsets = frame.offset(obstacles)
         top = float((offsets + ZONE * reach).max()) if len(obstacles) else 0.0
         return cls(frame, frame.project(obstacles), offsets, reach, FULL * reach, ZONE * reach,
-                   top,
-                   max(min_spacing, _SLOT_FACTOR * robot_radius),
-                   max(lane_spacing, (2.0 + MARGIN) * robot_radius))
+                   top, max(min_spacing, (2.0 + MARGIN) * robot_radius))
 
     def conflicting_pillars(self, robot_radius: float) -> np.ndarray:
         """
@@ -187,7 +217,7 @@ class DiscLayout:
 
 @dataclass(frozen=True)
 class Rise:
-    """The sidestep and rise of one configuration: e2 shifts (B,) and e1 offsets (B, k)."""
+    """The sidestep and rise of one configuration: e2 shifts (B, k) and e1 offsets (B, k)."""
 
     lift: np.ndarray
     shift: np.ndarray
@@ -195,7 +225,7 @@ class Rise:
     def positions(self, configuration: np.ndarray, frame: Frame) -> np.ndarray:
         """Return the (B + 1, k, d) breakpoints: C, then the robots after each push/rise."""
         moved = (configuration[None] + self.shift[..., None] * frame.e1
-                 + self.lift[:, None, None] * frame.e2)
+                 + self.lift[..., None] * frame.e2)
         return np.concatenate([configuration[None], moved])
 
 
@@ -208,26 +238,32 @@ def rise(p: np.ndarray, h: np.ndarray, layout: DiscLayout) -> Rise:
     """
     Return the sidestep and rise of a configuration with projections p and offsets h (k,).
 
-    The breakpoints are s = 0 (after the sidestep), T, and every s in (0, T)
-    where a robot in a pillar's shadow crosses an edge of its zone (module docstring).
+    Robot i rises by min(s, s_i), s_i = max(0, top + beta (h_i - h_min) - h_i)
+    its stop, for s from 0 to T = max_i s_i. The breakpoints are s = 0 (after
+    the sidestep), every stop, and every s in (0, T) where a robot in a pillar's
+    shadow crosses an edge of its zone (module docstring).
     """
     if layout.reach.size == 0:
-        return Rise(np.zeros(1), np.zeros((1, len(p))))
-    total = max(0.0, layout.top - float(h.min()))
+        return Rise(np.zeros((1, len(p))), np.zeros((1, len(p))))
+    low = float(h.min())
+    compression = COMPRESSION if len(h) <= COMPRESSED_ROBOTS else 1.0
+    # (top - h_min) - (1 - beta) (h_i - h_min): with beta = 1 every stop is the same float.
+    stops = np.maximum(0.0, (layout.top - low) - (1.0 - compression) * (h - low))
+    total = float(stops.max())
     signed = p[:, None] - layout.pillar_projections[None, :]
     robots, pillars = np.nonzero(np.abs(signed) < layout.reach[None, :])
-    if robots.size == 0:
-        return Rise(np.array([0.0, total]), np.zeros((2, len(p))))
     reach, full, zone = layout.reach[pillars], layout.full[pillars], layout.zone[pillars]
-    # Zone edges in s: u = h + s - h_q crosses -zone, -full, full, zone.
+    # Zone edges in s: u = h + s - h_q crosses -zone, -full, full, zone (all before the
+    # robot's stop, which is above every zone).
     edges = (layout.pillar_offsets[pillars] - h[robots])[:, None] + np.stack(
         [-zone, -full, full, zone], axis=1)
-    lift = np.unique(np.concatenate([[0.0, total], np.clip(edges.ravel(), 0.0, total)]))
-    relative = h[robots][:, None] + lift[None, :] - layout.pillar_offsets[pillars][:, None]
+    levels = np.unique(np.concatenate([[0.0], stops, np.clip(edges.ravel(), 0.0, total)]))
+    lift = np.minimum(levels[:, None], stops[None, :])
+    relative = h[robots][:, None] + lift[:, robots].T - layout.pillar_offsets[pillars][:, None]
     depth = reach - np.abs(signed[robots, pillars])
     direction = np.where(signed[robots, pillars] >= 0, 1.0, -1.0)
     push = push_factor(relative, full[:, None], zone[:, None]) * (direction * depth)[:, None]
-    shift = np.zeros((lift.size, len(p)))
+    shift = np.zeros(lift.shape)
     np.add.at(shift.T, robots, push)
     return Rise(lift, shift)
 
@@ -239,15 +275,14 @@ def staging_ranks(p: np.ndarray) -> np.ndarray:
     return rank
 
 
-def staging_slots(p: np.ndarray, rank: np.ndarray, layout: DiscLayout) -> np.ndarray:
+def staging_slots(p: np.ndarray, rank: np.ndarray, pitch: float) -> np.ndarray:
     """
-    Return the (k, d) slots of the staging line for robots of projections p (k,).
+    Return the (k,) projections of the slots for robots of projections p (k,).
 
     Slot rank(x) lies (rank - (k - 1) / 2) g along e1 from the mean robot
-    projection, on the line at height top.
+    projection.
     """
-    along = p.mean() + (rank - (len(rank) - 1) / 2) * layout.slot_spacing
-    return layout.frame.axis_points(along) + layout.top * layout.frame.e2
+    return p.mean() + (rank - (len(rank) - 1) / 2) * pitch
 
 
 def shared_lanes(first: np.ndarray, second: np.ndarray) -> np.ndarray:
@@ -291,7 +326,7 @@ def section(configurations: np.ndarray, layout: DiscLayout) -> DiscSection:
     breakpoints, exactly.
     """
     n, k, _ = configurations.shape
-    e2 = layout.frame.e2
+    e1, e2 = layout.frame.e1, layout.frame.e2
     deformations = []
     projections = layout.frame.project(configurations)
     offsets = layout.frame.offset(configurations)
@@ -299,23 +334,31 @@ def section(configurations: np.ndarray, layout: DiscLayout) -> DiscSection:
         risen = rise(p, h, layout).positions(configuration, layout.frame)
         names = [SIDESTEP] + [RISE] * (len(risen) - 2)
         rank = staging_ranks(p)
-        deformations.append((risen, names, rank, staging_slots(p, rank, layout)))
+        # The gather moves along e1 only, into the slots' columns, at the risen heights; a
+        # slot is its column at height top, other coordinates (d >= 3) kept.
+        columns = risen[-1] + (staging_slots(p, rank, layout.pitch) - p)[:, None] * e1
+        slots = columns + (layout.top - layout.frame.offset(columns))[:, None] * e2
+        deformations.append((risen, names, rank, slots, columns))
     stages, names, ends, heights = [configurations[0]], [''], [], set()
     for m in range(n - 1):
-        risen, rise_names, rank, slots = deformations[m]
-        back, back_names, next_rank, next_slots = deformations[m + 1]
-        lift = (1.0 + shared_lanes(rank, next_rank)) * layout.lane_pitch
+        risen, rise_names, rank, slots, columns = deformations[m]
+        back, back_names, next_rank, next_slots, next_columns = deformations[m + 1]
+        # Lane 0 is the staging height itself: its robots need no lift.
+        lift = shared_lanes(rank, next_rank) * layout.pitch
         heights.update((layout.top + lift).tolist())
-        stages += [*risen[1:], slots, slots + lift[:, None] * e2,
-                   next_slots + lift[:, None] * e2, next_slots, back[-1], *back[-2::-1]]
+        stages += [*risen[1:], columns, slots + lift[:, None] * e2,
+                   next_slots + lift[:, None] * e2, next_columns, back[-1], *back[-2::-1]]
         names += [*rise_names, GATHER, LIFT, SLIDE, DROP, GATHER + '^-1',
                   *(name + '^-1' for name in back_names[::-1])]
         stages[-1] = configurations[m + 1]
         ends.append(len(stages) - 1)
     every = np.stack(stages)
     # A stage equal to the one before it (a leg in which no robot moves) is left out;
-    # a configuration left out that way is bit for bit the stage kept before it.
+    # a configuration left out that way is bit for bit the stage kept before it. The
+    # configurations are kept all the same, so a segment in which no robot moves keeps one
+    # leg (of length 0) and every waypoint its own breakpoint.
     kept = np.concatenate([[True], np.any(every[1:] != every[:-1], axis=(1, 2))])
+    kept[ends] = True
     waypoints = np.concatenate([[0], np.cumsum(kept)[ends] - 1])
     return DiscSection(every[kept], tuple(np.array(names)[kept][1:].tolist()), waypoints,
                        np.array(sorted(heights)))

@@ -132,8 +132,13 @@ def union_motion(times: np.ndarray, positions: np.ndarray,
     extra = knots[~np.isin(knots, times)]
     leg = np.clip(np.searchsorted(times, extra, side='right') - 1, 0, times.size - 2)
     fraction = ((extra - times[leg]) / (times[leg + 1] - times[leg]))[:, None, None]
-    # (1 - f) a + f b, as Plan.position evaluates x.
-    inserted = (1.0 - fraction) * positions[leg] + fraction * positions[leg + 1]
+    # (1 - f) a + f b, as Plan.position evaluates x, kept per coordinate between a and b,
+    # where the exact point lies: rounded, (1 - f) a + f a can be an ulp off a, and a robot
+    # exactly at a wall would then be an ulp beyond it (clipping only moves towards the
+    # exact value, continuously).
+    start, end = positions[leg], positions[leg + 1]
+    inserted = np.clip((1.0 - fraction) * start + fraction * end, np.minimum(start, end),
+                       np.maximum(start, end))
     all_times = np.concatenate([times, extra])
     order = np.argsort(all_times, kind='stable')
     rank = np.empty_like(order)

@@ -34,7 +34,9 @@ def length_times(positions: np.ndarray, waypoint_indices: np.ndarray) -> np.ndar
 
     Inside a segment each leg takes a share of [tau_m, tau_{m+1}] proportional
     to its length (its fastest robot's displacement): continuous in the
-    positions, and a leg of length 0 takes no time.
+    positions, and a leg of length 0 takes no time. In a segment in which no
+    robot moves the legs share it evenly: the motion is the same whatever the
+    shares, and moves by no more than the segment's length near such a segment.
     """
     n = len(waypoint_indices)
     lengths = leg_lengths(positions)
@@ -42,7 +44,9 @@ def length_times(positions: np.ndarray, waypoint_indices: np.ndarray) -> np.ndar
     for m in range(n - 1):
         first, last = waypoint_indices[m], waypoint_indices[m + 1]
         cumulative = np.concatenate([[0.0], np.cumsum(lengths[first:last])])
-        times[first:last + 1] = (m + cumulative / cumulative[-1]) / (n - 1)
+        shares = (cumulative / cumulative[-1] if cumulative[-1] > 0
+                  else np.linspace(0.0, 1.0, cumulative.size))
+        times[first:last + 1] = (m + shares) / (n - 1)
     times[waypoint_indices] = np.arange(n) / (n - 1)
     return times
 

@@ -71,12 +71,15 @@ class PlannerSettings:
     obstacle_radius: tuple = OBSTACLE_RADIUS.field()
     lane_spacing: float = Spec(
         'lane_spacing', 'double', 1.0,
-        'Spacing of the lanes the robots slide along (m); 1 gives the paper heights.',
+        'Paper and spread variants: spacing of the lanes the robots slide along (m); 1 '
+        'gives the paper heights. The discs variant spaces its lanes as its slots '
+        '(min_spacing).',
         low=1e-6, high=1e6).field()
     min_spacing: float = Spec(
         'min_spacing', 'double', 0.5,
         'Spread variant: spacing g the spreading leg aims for between robots on the '
-        'axis and from the obstacles (m).', low=1e-6, high=1e6).field()
+        'axis and from the obstacles (m). Discs variant: the pitch of its staging slots '
+        'and lanes, at least 2.1 robot radii.', low=1e-6, high=1e6).field()
     required_clearance: float = Spec(
         'required_clearance', 'double', 0.0,
         'Refuse a plan whose certified minimum clearance is below this (m); 0 accepts '
