@@ -295,6 +295,22 @@ def format_table(rows):
     return '\n'.join(lines)
 
 
+def progress_printer():
+    """Return a progress callback printing each label with the seconds since this call."""
+    start = time.perf_counter()
+    return lambda label: print(f'{time.perf_counter() - start:7.1f} s  {label}',
+                               file=sys.stderr, flush=True)
+
+
+def grid_main(doc, report, quick_settings, settings, argv=None):
+    """Run a grid benchmark from the command line: ``--quick`` for its smoke grid."""
+    parser = argparse.ArgumentParser(description=doc.strip().splitlines()[0])
+    parser.add_argument('--quick', action='store_true', help='a small grid (smoke run)')
+    args = parser.parse_args(argv)
+    print('\n'.join(report(quick_settings() if args.quick else settings())))
+    sys.stdout.flush()
+
+
 def main(argv=None):
     """Print the core speed figures (and profiles with --profile)."""
     parser = argparse.ArgumentParser(description=__doc__.strip().splitlines()[0])

@@ -16,12 +16,10 @@ lattice cells, pillar pairs checked against condition (c)).
 Run alone: ``.venv/bin/python bench/discs.py [--quick]``.
 """
 
-import argparse
 from dataclasses import dataclass
-import sys
 import time
 
-from core_speed import format_table
+from core_speed import format_table, grid_main, progress_printer
 import numpy as np
 import peers
 
@@ -294,18 +292,13 @@ def summary(results, condition, ratios):
 
 def report(settings):
     """Run the benchmark; return its Markdown lines: the targets, then the table per k."""
-    start = time.perf_counter()
-    results, condition, ratios = run(settings, lambda label: print(
-        f'{time.perf_counter() - start:7.1f} s  {label}', file=sys.stderr, flush=True))
+    results, condition, ratios = run(settings, progress_printer())
     return summary(results, condition, ratios) + ['', format_table(share_rows(results))]
 
 
 def main(argv=None):
     """Run the benchmark and print its tables."""
-    parser = argparse.ArgumentParser(description=__doc__.strip().splitlines()[0])
-    parser.add_argument('--quick', action='store_true', help='a small grid (smoke run)')
-    args = parser.parse_args(argv)
-    print('\n'.join(report(quick_settings() if args.quick else Settings())))
+    grid_main(__doc__, report, quick_settings, Settings, argv)
 
 
 if __name__ == '__main__':

@@ -15,12 +15,10 @@ share of the box's longest side.
 Run alone: ``.venv/bin/python bench/hall.py [--quick]``.
 """
 
-import argparse
 from dataclasses import dataclass
-import sys
 import time
 
-from core_speed import format_table
+from core_speed import format_table, grid_main, progress_printer
 import numpy as np
 from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
 from refinement import PILLAR, RADIUS, realistic_fleet
@@ -142,19 +140,13 @@ def summary(outcomes: list[Outcome]) -> list[str]:
 
 def report(settings: Settings) -> list[str]:
     """Run the benchmark; return its Markdown lines: the headline, then the table."""
-    start = time.perf_counter()
-    outcomes = run(settings, lambda label: print(
-        f'{time.perf_counter() - start:7.1f} s  {label}', file=sys.stderr, flush=True))
+    outcomes = run(settings, progress_printer())
     return summary(outcomes) + ['', format_table(table(outcomes))]
 
 
 def main(argv=None):
     """Run the benchmark and print its figures."""
-    parser = argparse.ArgumentParser(description=__doc__.strip().splitlines()[0])
-    parser.add_argument('--quick', action='store_true', help='a small grid (smoke run)')
-    args = parser.parse_args(argv)
-    print('\n'.join(report(quick_settings() if args.quick else Settings())))
-    sys.stdout.flush()
+    grid_main(__doc__, report, quick_settings, Settings, argv)
 
 
 if __name__ == '__main__':

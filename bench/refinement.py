@@ -19,12 +19,11 @@ validity check in Python; its time is given with and without that checker.
 Run alone: ``.venv/bin/python bench/refinement.py [--quick]``.
 """
 
-import argparse
 from dataclasses import dataclass, field
 import sys
 import time
 
-from core_speed import format_table
+from core_speed import format_table, grid_main, progress_printer
 import numpy as np
 import peers
 
@@ -297,19 +296,13 @@ def summary(results):
 
 def report(settings):
     """Run the benchmark; return its Markdown lines: the targets, then the table."""
-    start = time.perf_counter()
-    results = run(settings, lambda label: print(
-        f'{time.perf_counter() - start:7.1f} s  {label}', file=sys.stderr, flush=True))
+    results = run(settings, progress_printer())
     return summary(results) + ['', format_table(table(results))]
 
 
 def main(argv=None):
     """Run the benchmark and print its figures."""
-    parser = argparse.ArgumentParser(description=__doc__.strip().splitlines()[0])
-    parser.add_argument('--quick', action='store_true', help='a small grid (smoke run)')
-    args = parser.parse_args(argv)
-    print('\n'.join(report(quick_settings() if args.quick else Settings())))
-    sys.stdout.flush()
+    grid_main(__doc__, report, quick_settings, Settings, argv)
 
 
 if __name__ == '__main__':
