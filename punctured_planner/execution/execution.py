@@ -66,11 +66,30 @@ class ExecutionSettings:
     yaw_rate_limit: float = 1.0         # rad/s, differential robots
     final_heading: bool = True          # differential robots end facing their last pose
     # 1/s: how fast each robot's feed-forward gain learns its lag along its reference; 0: off
-    feedforward_adaptation: float = 0.3
+    feedforward_adaptation: float = 1.0
+    # each robot's own speed (m/s) and acceleration (m/s^2) limits: one value, or one per
+    # robot in plan order; empty: the plan's. The clock's reference is timed for them.
+    max_speeds: tuple = ()
+    max_accelerations: tuple = ()
 
     def differential(self, robot_count: int) -> np.ndarray:
         """Return the (k,) mask of differential robots; ValueError if drive does not fit k."""
         return differential_mask(self.drive, robot_count)
+
+    def limits(self, robot_count: int) -> tuple[np.ndarray | None, np.ndarray | None]:
+        """Return (k,) max_speeds and max_accelerations (None: the plan's); ValueError on k."""
+        return (per_robot('max_speeds', self.max_speeds, robot_count),
+                per_robot('max_accelerations', self.max_accelerations, robot_count))
+
+
+def per_robot(name: str, values: tuple, robot_count: int) -> np.ndarray | None:
+    """Return values (one, or one per robot) as (k,), None for none; ValueError if not k."""
+    if not values:
+        return None
+    if len(values) not in (1, robot_count):
+        raise ValueError('%s has %d values for %d robots (one, or one per robot)'
+                         % (name, len(values), robot_count))
+    return np.broadcast_to(np.asarray(values, dtype=float), robot_count).copy()
 
 
 def differential_mask(drive: tuple, robot_count: int) -> np.ndarray:
@@ -109,19 +128,41 @@ class Execution:
 
     def __init__(self, reference: Reference, tolerance: float, settings: ExecutionSettings,
                  bodies: Bodies | None = None):
-        """Start at plan time 0 with no error measured yet; ValueError if drive does not fit."""
-        self.reference = reference
+        """
+        Start at plan time 0 with no error measured yet; ValueError if drive does not fit.
+
+        With robots slower than the plan (settings.max_speeds, max_accelerations)
+        the clock runs on the plan retimed for them (Reference.retimed): its
+        plan time is then that timing's.
+        """
         self.tolerance = float(tolerance)
+        k = reference.robot_count
+        speeds, accelerations = settings.limits(k)
+        profile = reference.profile
+        plan_acceleration = np.full(k, profile.max_acceleration if profile else np.inf)
+        # (k,) each robot's acceleration limit as the clock's rise sees it
+        self.accelerations = (plan_acceleration if accelerations is None
+                              else np.minimum(accelerations, plan_acceleration))
+        self.differential = settings.differential(k)
+        # a timed plan stops where a differential robot must turn in place (its clock then
+        # holds with every robot at rest, doc/design.md section 13)
+        stops = (unicycle.Corners(reference.seconds, reference.positions).turns(
+            self.differential) if profile is not None else np.zeros(0, dtype=bool))
+        if speeds is not None or accelerations is not None or stops.any():
+            reference = reference.retimed(
+                np.full(k, np.inf) if speeds is None else speeds,
+                self.accelerations, 2.0 * self.tolerance, stops if stops.any() else None)
+        self.reference = reference
         self.settings = settings
         self.bodies = bodies if bodies is not None else Bodies()
         self.plan_time = 0.0
         self.max_errors = np.zeros(reference.robot_count)
         self.min_gap = np.inf
-        self.differential = settings.differential(reference.robot_count)
         self.lead = unicycle.lead(self.tolerance, settings.slow_fraction,
                                   settings.hold_fraction)
         self.steering = unicycle.steering(self.lead)
-        self.corners = unicycle.Corners(reference.seconds, reference.positions)
+        self.corners = unicycle.Corners(reference.seconds, reference.positions,
+                                        reference.at_rest() if profile is not None else None)
         self.final_yaws = unicycle.yaws(reference.orientation(reference.duration))
         self.turning = np.zeros(reference.robot_count, dtype=bool)
         # robots driving backward: their lead point is e behind, their 'heading' theta + pi
@@ -130,15 +171,19 @@ class Execution:
         # (k,) what each robot's feed-forward is multiplied by: 1 until it lags (_feedforward)
         self.feedforward_gains = np.ones(reference.robot_count)
         self.rate = 0.0        # the clock's last rate
+        self.commanded_speeds = np.zeros(reference.robot_count)  # (k,) the last commands' m/s
 
     def step(self, dt: float, positions: np.ndarray, stale: np.ndarray,
-             orientations: np.ndarray | None = None) -> Step:
+             orientations: np.ndarray | None = None, ages: np.ndarray | None = None) -> Step:
         """
         Advance by dt seconds for robot positions (k, 3) and stale flags (k,); return the Step.
 
         orientations (k, 4) are the robots' quaternions (None: identity); the
         differential robots' headings are their yaws. The positions of stale
-        robots are not used (their errors count as 0 this step).
+        robots are not used (their errors count as 0 this step). ages (k,) are
+        how old the positions are (s; None: fresh): the clock counts what a
+        robot may have moved since, beyond one control step, as error
+        (:meth:`_unseen`).
         """
         s = self.settings
         stale = np.asarray(stale, dtype=bool)
@@ -163,6 +208,7 @@ class Execution:
                                + self.lead, errors)
             alpha = self._update_turns(angles, watched)
         driving = self._driving(angles)
+        watched = watched + self._unseen(ages, dt)
         if not s.shared_clock:
             rate = 1.0
         elif stale.any():
@@ -187,27 +233,45 @@ class Execution:
             velocities = np.where(differential[:, None],
                                   forward[:, None] * unicycle.headings(angles), velocities)
         velocities[stale] = 0.0
+        self.commanded_speeds = np.where(differential, np.abs(forward),
+                                         np.linalg.norm(velocities, axis=1))
         arrived = bool(self.plan_time >= duration and not stale.any() and np.all(
             np.linalg.norm(target - positions, axis=1) <= s.goal_tolerance))
         finished = self._settled(arrived, angles, dt) and arrived
         return Step(self.plan_time, rate, target, self.reference.orientation(self.plan_time),
                     velocities, errors, finished, self.differential.copy(), forward, yaw_rates)
 
+    def _unseen(self, ages: np.ndarray | None, dt: float) -> np.ndarray:
+        """
+        Return the (k,) distances the robots may have moved since their odometry, beyond dt.
+
+        A robot whose odometry is a seconds old has moved about a x its speed
+        since (its last command's speed): at 0.5 m/s a stalled simulator's
+        0.5 s is 0.25 m, more than delta. One control step of age is the
+        sampling the margin (1 - hold_fraction) delta covers already; the rest
+        counts as tracking error, so the clock slows and holds while the
+        positions it sees are old (doc/design.md section 13).
+        """
+        if ages is None:
+            return np.zeros(self.reference.robot_count)
+        return np.maximum(np.asarray(ages, dtype=float) - dt, 0.0) * self.commanded_speeds
+
     def _rate_rise(self, wanted: float, dt: float) -> float:
         """
         Return wanted, or less where the clock would speed up faster than the plan allows.
 
-        Under the plan's acceleration limit a, the clock rises no faster than
-        lets the fastest reference's velocity rate x r'(s) grow by a dt: released
-        from a hold at once, every robot limited to a would lag its reference's
-        jump by up to v^2 / (2 a) and hold the clock again. It still slows and
-        holds at once. A plan without the limit keeps the clock's rate as it is.
+        Under acceleration limits a_i (the plan's, or each robot's own) the
+        clock rises no faster than lets every reference's velocity rate x r_i'(s)
+        grow by a_i dt: released from a hold at once, a robot limited to a_i
+        would lag its reference's jump by up to v^2 / (2 a_i) and hold the
+        clock again. It still slows and holds at once. A plan without the
+        limit keeps the clock's rate as it is.
         """
-        profile = self.reference.profile
-        if profile is None:
+        if self.reference.profile is None:
             return wanted
-        speed = float(np.linalg.norm(self.reference.velocity(self.plan_time), axis=1).max())
-        return min(wanted, self.rate + profile.max_acceleration * dt / max(speed, ADAPT_SPEED))
+        speeds = np.linalg.norm(self.reference.velocity(self.plan_time), axis=1)
+        rise = float(np.min(self.accelerations / np.maximum(speeds, ADAPT_SPEED)))
+        return min(wanted, self.rate + rise * dt)
 
     def _feedforward(self, rate: float, dt: float, lags: np.ndarray,
                      stale: np.ndarray) -> np.ndarray:
@@ -224,6 +288,8 @@ class Execution:
         toward 1 while it is ahead: a robot that achieves only a fraction f of
         its commands gets about 1 / f of the feed-forward and keeps the pace
         the clock sets instead of the much lower K e of its feedback alone.
+        A gain does not grow while its feed-forward alone reaches the speed
+        limit (anti-windup: the robot cannot go faster).
         With the clock held (rate 0) there is no feed-forward, so the hold's
         argument (doc/design.md section 13) is unchanged.
         """
@@ -235,6 +301,11 @@ class Execution:
         along = np.einsum('kd,kd->k', lags, velocity) / np.maximum(speeds, ADAPT_SPEED)
         waited = self.settings.slow_fraction * self.tolerance
         excess = np.where(along > waited, along - waited, np.minimum(along, 0.0))
+        # no growth while the feed-forward alone is at the speed limit: a larger gain would
+        # not move the robot faster, only wind up (and overshoot once the reference slows)
+        saturated = (self.feedforward_gains * np.linalg.norm(feedforward, axis=1)
+                     >= self.settings.speed_limit)
+        excess = np.where(saturated, np.minimum(excess, 0.0), excess)
         change = self.settings.feedforward_adaptation * dt * excess / self.tolerance
         self.feedforward_gains = np.clip(
             np.where(moving, self.feedforward_gains + change, self.feedforward_gains),
