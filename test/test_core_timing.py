@@ -157,8 +157,8 @@ def test_fleet_profile_keeps_every_robot_within_its_own_limits(line, seed, gap):
 
 @settings(max_examples=50, deadline=None)
 @given(polylines, st.floats(0.05, 5.0), st.floats(0.05, 5.0), st.floats(0.0, 1.0))
-def test_fleet_profile_at_the_plans_limits_is_the_plans_profile(line, speed, acceleration,
-                                                                 gap):
+def test_fleet_profile_at_the_plans_limits_is_the_plans_profile(
+        line, speed, acceleration, gap):
     """Every robot at max_speed and max_acceleration, no stop: the planner's own stamps."""
     positions = random_polyline(*line)
     k = positions.shape[1]

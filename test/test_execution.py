@@ -388,8 +388,8 @@ def test_a_slow_robot_known_up_front_holds_the_clock_less():
     reference, bodies, gap = certified_fleet(acceleration=1.0)
     k = reference.robot_count
     runs = {}
-    for label, speeds in (('unknown', ()), ('known', tuple(np.where(np.arange(k) == 0, 0.25,
-                                                                     0.5)))):
+    known = tuple(np.where(np.arange(k) == 0, 0.25, 0.5))
+    for label, speeds in (('unknown', ()), ('known', known)):
         fleet = Fleet(reference.position(0.0), FleetSettings(
             bodies=bodies, speed_limit=0.5, speed_factors=np.where(np.arange(k) == 0, 0.5, 1),
             velocity_noise=0.05, seed=3, max_acceleration=1.0))
