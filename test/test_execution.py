@@ -409,17 +409,24 @@ def test_a_slow_robot_known_up_front_holds_the_clock_less():
     assert runs['known'] < 0.75 * runs['unknown']   # 466 against 757 steps when written
 
 
-def test_old_odometry_counts_as_tracking_error():
-    """Positions 0.4 s old of a robot commanded 1 m/s: 0.35 m unseen, the clock holds."""
+def test_old_odometry_is_compared_then_and_counts_as_error():
+    """A position 0.4 s old is compared with the reference of 0.4 s ago; the clock holds."""
     reference = reference_of([0.0, 10.0], [[[0, 0, 0]], [[10, 0, 0]]])
     execution = Execution(reference, 0.5, ExecutionSettings(speed_limit=2.0))
-    step = execution.step(0.05, reference.position(0.0), [False], ages=[0.0])
+    for _ in range(20):
+        step = execution.step(0.05, reference.position(execution.plan_time), [False],
+                              ages=[0.0])
     assert step.rate == 1.0 and np.linalg.norm(step.velocities[0]) > 0.9
-    fresh = execution.step(0.05, reference.position(execution.plan_time), [False], ages=[0.05])
+    then = reference.position(execution.plan_time - 0.05)
+    fresh = execution.step(0.05, then, [False], ages=[0.05])
     assert fresh.rate == 1.0, 'one control step of age is the sampling the margin covers'
-    held = execution.step(0.05, reference.position(execution.plan_time), [False], ages=[0.4])
-    assert held.rate == 0.0
-    assert held.errors[0] == pytest.approx(0.0), 'the reported error is the measured one'
+    assert fresh.errors[0] == pytest.approx(0.0, abs=1e-9)
+    then = reference.position(execution.plan_time - 0.4)
+    held = execution.step(0.05, then, [False], ages=[0.4])
+    assert held.errors[0] == pytest.approx(0.0, abs=1e-9), 'on its reference 0.4 s ago'
+    assert held.rate == 0.0, 'it may have moved 0.35 m since: more than hold_fraction delta'
+    measured_now = execution.step(0.05, then, [False])
+    assert measured_now.errors[0] == pytest.approx(0.4), 'without its age: 0.4 m behind'
 
 
 def test_feedforward_gain_does_not_wind_up_at_the_speed_limit():

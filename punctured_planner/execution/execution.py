@@ -29,6 +29,7 @@ for SETTLE seconds: a robot late behind the clock reaches its goal at speed,
 and one control step inside the tolerance would stop it centimetres beyond.
 """
 
+from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
@@ -40,6 +41,9 @@ from .tolerance import clock_rate
 
 # Longest step the clock takes at once (s): a stalled control loop does not jump ahead.
 MAX_STEP = 0.2
+# Control steps of the clock kept to find the plan time at which an old position was taken
+# (5 s at 20 Hz; odom_timeout declares older odometry stale).
+HISTORY = 100
 # Seconds every robot must stay at its goal (and final heading) before the run is finished.
 SETTLE = 0.5
 # Largest feed-forward gain: a robot that achieves a quarter of its commands is not helped.
@@ -172,6 +176,9 @@ class Execution:
         self.feedforward_gains = np.ones(reference.robot_count)
         self.rate = 0.0        # the clock's last rate
         self.commanded_speeds = np.zeros(reference.robot_count)  # (k,) the last commands' m/s
+        self.elapsed = 0.0     # seconds of control steps so far
+        # (elapsed, plan time read) at each of the last HISTORY steps, for old positions
+        self.clock_history: deque = deque(maxlen=HISTORY)
 
     def step(self, dt: float, positions: np.ndarray, stale: np.ndarray,
              orientations: np.ndarray | None = None, ages: np.ndarray | None = None) -> Step:
@@ -181,16 +188,19 @@ class Execution:
         orientations (k, 4) are the robots' quaternions (None: identity); the
         differential robots' headings are their yaws. The positions of stale
         robots are not used (their errors count as 0 this step). ages (k,) are
-        how old the positions are (s; None: fresh): the clock counts what a
-        robot may have moved since, beyond one control step, as error
-        (:meth:`_unseen`).
+        how old the positions are (s; None: fresh): each is compared with its
+        reference at the plan time of that instant (:meth:`_measured`), and
+        the clock counts what a robot may have moved since, beyond one control
+        step, as error (:meth:`_unseen`).
         """
         s = self.settings
         stale = np.asarray(stale, dtype=bool)
         k = self.reference.robot_count
         angles = (np.zeros(k) if orientations is None else unicycle.yaws(orientations))
-        reference_now = self.reference.position(self.plan_time)
-        errors = np.linalg.norm(reference_now - positions, axis=1)
+        self.elapsed += max(dt, 0.0)
+        self.clock_history.append((self.elapsed, self.plan_time))
+        measured_reference = self._measured(ages)
+        errors = np.linalg.norm(measured_reference - positions, axis=1)
         errors[stale] = 0.0
         self.max_errors = np.maximum(self.max_errors, errors)
         if not stale.any():
@@ -204,7 +214,7 @@ class Execution:
             # the clock watches each differential robot's bound E of its centre error
             lead_points = unicycle.lead_points(positions, self._driving(angles), self.lead)
             watched = np.where(differential,
-                               np.linalg.norm(reference_now - lead_points, axis=1)
+                               np.linalg.norm(measured_reference - lead_points, axis=1)
                                + self.lead, errors)
             alpha = self._update_turns(angles, watched)
         driving = self._driving(angles)
@@ -221,7 +231,7 @@ class Execution:
         duration = self.reference.duration
         self.plan_time = min(duration, self.plan_time + rate * dt)
         target = self.reference.position(self.plan_time)
-        feedforward = self._feedforward(rate, dt, reference_now - positions, stale)
+        feedforward = self._feedforward(rate, dt, measured_reference - positions, stale)
         command = feedforward + s.gain * (target - positions)
         velocities = saturate(command, s.speed_limit)
         forward, yaw_rates = np.zeros(k), np.zeros(k)
@@ -240,6 +250,28 @@ class Execution:
         finished = self._settled(arrived, angles, dt) and arrived
         return Step(self.plan_time, rate, target, self.reference.orientation(self.plan_time),
                     velocities, errors, finished, self.differential.copy(), forward, yaw_rates)
+
+    def _measured(self, ages: np.ndarray | None) -> np.ndarray:
+        """
+        Return the (k, 3) references at the plan times the robots' positions were taken at.
+
+        A position ages (k,) seconds old (by arrival: an upper bound of its age)
+        is compared with its reference at the clock of that instant, from the
+        clock's last HISTORY steps (older: the oldest kept): a robot exactly on
+        its reference 0.3 s ago is not 0.3 s x v behind it. The certificate
+        needs every robot within delta of its reference at one and the same
+        plan time, which is what this compares; without ages (or 0) it is the
+        current plan time.
+        """
+        if ages is None or not np.any(np.asarray(ages) > 0):
+            return self.reference.position(self.plan_time)
+        times, plan_times = np.array(self.clock_history).T
+        then = np.interp(self.elapsed - np.asarray(ages, dtype=float), times, plan_times)
+        result = np.empty((self.reference.robot_count, 3))
+        for s_then in np.unique(then):
+            robots = then == s_then
+            result[robots] = self.reference.position(float(s_then))[robots]
+        return result
 
     def _unseen(self, ages: np.ndarray | None, dt: float) -> np.ndarray:
         """
