@@ -443,3 +443,19 @@ def test_feedforward_gain_does_not_wind_up_at_the_speed_limit():
         gains[limit] = execution.feedforward_gains[0]
     assert gains[1.0] == 1.0, 'its feed-forward alone, 1.2 m/s, is beyond the limit'
     assert gains[3.0] > 1.0, 'below the limit the same lag is learnt'
+
+
+def test_a_robot_ahead_of_its_reference_does_not_hold_the_clock():
+    """0.35 m ahead: the clock runs (a hold would let it overshoot); 0.35 m behind: it holds."""
+    reference = reference_of([0.0, 10.0], [[[0, 0, 0]], [[10, 0, 0]]])
+    for offset, rate in ((0.35, 1.0), (-0.35, 0.0)):
+        execution = Execution(reference, 0.5, ExecutionSettings(speed_limit=2.0))
+        execution.step(0.05, reference.position(0.0), [False])
+        step = execution.step(0.05, reference.position(execution.plan_time) + [[offset, 0, 0]],
+                              [False])
+        assert step.rate == rate and step.errors[0] == pytest.approx(0.35)
+    sideways = Execution(reference, 0.5, ExecutionSettings(speed_limit=2.0))
+    sideways.step(0.05, reference.position(0.0), [False])
+    step = sideways.step(0.05, reference.position(sideways.plan_time) + [[0.1, 0.35, 0]],
+                         [False])
+    assert step.rate == 0.0, 'its sideways error counts, ahead or not'

@@ -120,6 +120,23 @@ class Step:
     yaw_rates: np.ndarray       # (k,) differential robots' yaw rates (rad/s), else 0
 
 
+def behind(lags: np.ndarray, motion: np.ndarray) -> np.ndarray:
+    """
+    Return the (k,) parts of lags (reference - position, (k, 3)) that a slower clock reduces.
+
+    A robot behind its reference moving along motion (k, 3), or beside it, is
+    helped by the clock waiting: its whole lag counts. A robot ahead of it is
+    not (the reference catches up only while the clock runs, and a hold makes
+    a robot at speed overshoot further): only its sideways part counts. A
+    reference standing still: the whole lag.
+    """
+    speeds = np.linalg.norm(motion, axis=1)
+    along = np.einsum('kd,kd->k', lags, motion) / np.maximum(speeds, np.finfo(float).tiny)
+    distance = np.linalg.norm(lags, axis=1)
+    sideways = np.sqrt(np.maximum(distance ** 2 - along ** 2, 0.0))
+    return np.where((speeds > 0) & (along < 0), sideways, distance)
+
+
 def saturate(velocities: np.ndarray, limit: float | np.ndarray) -> np.ndarray:
     """Return (k, 3) velocities scaled down to speed at most limit, direction kept."""
     speeds = np.linalg.norm(velocities, axis=-1, keepdims=True)
@@ -209,14 +226,17 @@ class Execution:
         dt = min(max(dt, 0.0), MAX_STEP)
         # An all-holonomic fleet (the default) needs none of the unicycle's work.
         unicycles = bool(self.differential.any())
-        watched, alpha = errors, np.zeros(k)
+        motion = self.reference.velocity(self.plan_time)
+        watched, alpha = behind(measured_reference - positions, motion), np.zeros(k)
         if unicycles:
             # the clock watches each differential robot's bound E of its centre error
             lead_points = unicycle.lead_points(positions, self._driving(angles), self.lead)
-            watched = np.where(differential,
-                               np.linalg.norm(measured_reference - lead_points, axis=1)
-                               + self.lead, errors)
+            bound = np.linalg.norm(measured_reference - lead_points, axis=1) + self.lead
+            watched = np.where(differential, bound, errors)
             alpha = self._update_turns(angles, watched)
+            watched = np.where(differential,
+                               behind(measured_reference - lead_points, motion) + self.lead,
+                               watched)
         driving = self._driving(angles)
         watched = watched + self._unseen(ages, dt)
         if not s.shared_clock:
