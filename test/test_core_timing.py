@@ -5,7 +5,7 @@ from hypothesis import settings
 from hypothesis import strategies as st
 import numpy as np
 from punctured_planner.core import plan, Workspace
-from punctured_planner.core.timing import corner_jump, speed_profile
+from punctured_planner.core.timing import corner_jump, fleet_profile, speed_profile
 from punctured_planner.execution import Reference
 import pytest
 
@@ -125,6 +125,48 @@ def test_profile_respects_both_limits_and_every_corner(line, speed, acceleration
         assert max(abs(state.acceleration) for state in states) <= acceleration
         # time_at inverts state_at
         assert np.allclose(profile.time_at(leg, distance), times, atol=1e-6 * (1 + times))
+
+
+@settings(max_examples=100, deadline=None)
+@given(polylines, st.integers(0, 2 ** 32 - 1), st.floats(0.0, 1.0))
+def test_fleet_profile_keeps_every_robot_within_its_own_limits(line, seed, gap):
+    """Robot i: speed <= its v_i, acceleration <= its a_i, corner jumps <= its J_i; stops."""
+    positions = random_polyline(*line)
+    rng = np.random.default_rng(seed)
+    k = positions.shape[1]
+    speeds, accelerations = rng.uniform(0.05, 2.0, k), rng.uniform(0.05, 2.0, k)
+    stops = rng.uniform(size=len(positions)) < 0.2
+    profile = fleet_profile(positions, speeds, accelerations, gap, stops)
+    assert profile.speeds[0] == 0.0 and profile.speeds[-1] == 0.0
+    assert np.all(profile.speeds[stops] == 0.0)
+    lengths = profile.lengths
+    moving = np.flatnonzero(lengths > 0)
+    steps = np.diff(positions, axis=0)
+    durations = profile.durations()
+    for leg in moving:
+        rates = np.linalg.norm(steps[leg], axis=1) / lengths[leg]         # |u_ij|
+        for t in np.linspace(0.0, durations[leg], 21):
+            state = profile.state_at(leg, t)
+            assert np.all(rates * state.speed <= speeds + 1e-9)
+            assert np.all(rates * abs(state.acceleration) <= accelerations + 1e-9)
+    rates = steps[moving] / lengths[moving][:, None, None]
+    jumps = np.linalg.norm(np.diff(rates, axis=0), axis=2) * profile.speeds[moving[1:], None]
+    allowed = np.array([corner_jump(a, gap) for a in accelerations])
+    assert np.all(jumps <= allowed + 1e-9)
+
+
+@settings(max_examples=50, deadline=None)
+@given(polylines, st.floats(0.05, 5.0), st.floats(0.05, 5.0), st.floats(0.0, 1.0))
+def test_fleet_profile_at_the_plans_limits_is_the_plans_profile(
+        line, speed, acceleration, gap):
+    """Every robot at max_speed and max_acceleration, no stop: the planner's own stamps."""
+    positions = random_polyline(*line)
+    k = positions.shape[1]
+    plan_stamps = speed_profile(positions, speed, acceleration,
+                                corner_jump(acceleration, gap)).stamps()
+    fleet_stamps = fleet_profile(positions, np.full(k, speed), np.full(k, acceleration),
+                                 gap).stamps()
+    assert np.allclose(fleet_stamps, plan_stamps, rtol=1e-9, atol=1e-9)
 
 
 def test_corners_are_slowed_into_and_straight_runs_are_not():

@@ -225,3 +225,28 @@ def test_a_reversal_is_driven_backward_not_turned_round():
     step = execution.step(0.05, reference.position(0.0), [False], quaternions([0.0]))
     assert execution.reverse.tolist() == [True] and not execution.turning.any()
     assert step.forward[0] < 0 and abs(step.yaw_rates[0]) < 1e-9
+
+
+def test_a_timed_plan_stops_where_a_differential_robot_turns_in_place():
+    """Under an acceleration limit a right angle is a stop at rest, with no corner ramp."""
+    positions = np.array([[[0, 0, 0], [0, 2, 0]], [[2, 0, 0], [2, 2, 0]],
+                          [[2, 2, 0], [4, 2, 0]]], dtype=float)
+    orientations = np.tile([0.0, 0.0, 0.0, 1.0], (3, 2, 1))
+    timed = Reference.timed(np.array([0.0, 3.0, 6.0]), positions, orientations, 1.0, 1.0, 0.5)
+    assert timed.profile.speeds[1] > 0, 'the plan passes its corner moving'
+    holonomic = Execution(timed, 0.25, ExecutionSettings(speed_limit=1.0))
+    assert holonomic.reference is timed
+    drive = ('differential', 'holonomic')
+    differential = Execution(timed, 0.25, ExecutionSettings(
+        drive=drive, speed_limit=1.0, yaw_rate_limit=1.9))
+    rests = differential.reference.at_rest()
+    assert rests.tolist() == [True, True, True], 'robot 0 turns by 90 degrees at pose 1'
+    assert np.array_equal(differential.reference.positions, positions)
+    corner = differential.reference.seconds[1]
+    caps = differential.corners.corner_caps(corner - 0.3, differential.steering, 1.9)
+    assert caps.tolist() == [1.0, 1.0], 'a stop at rest needs no ramp before it'
+    # the differential robot straight, the holonomic one turning: no stop
+    straight = positions.copy()
+    straight[2] = [[4, 0, 0], [2, 4, 0]]
+    plain = Reference.timed(np.array([0.0, 3.0, 6.0]), straight, orientations, 1.0, 1.0, 0.5)
+    assert Execution(plain, 0.25, ExecutionSettings(drive=drive)).reference is plain

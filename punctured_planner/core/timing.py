@@ -88,13 +88,20 @@ class SpeedProfile:
     leg sigma accelerates at max_acceleration, cruises at most at max_speed,
     then brakes at max_acceleration: the fastest bang-coast-bang between the
     breakpoint speeds, which the passes of :func:`speed_profile` keep
-    reachable.
+    reachable. Both limits are one value, or (L,) one per leg
+    (:func:`fleet_profile`: the robots' own limits).
     """
 
     lengths: np.ndarray
     speeds: np.ndarray
-    max_speed: float
-    max_acceleration: float
+    max_speed: float | np.ndarray
+    max_acceleration: float | np.ndarray
+
+    def _limits(self, leg: int) -> tuple[float, float]:
+        """Return leg's (max_speed, max_acceleration)."""
+        count = len(self.lengths)
+        return (float(np.broadcast_to(self.max_speed, count)[leg]),
+                float(np.broadcast_to(self.max_acceleration, count)[leg]))
 
     @cached_property
     def _phases(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -119,7 +126,7 @@ class SpeedProfile:
 
     def time_at(self, leg: int, distances: np.ndarray) -> np.ndarray:
         """Return the seconds from leg's start at which sigma has moved distances along it."""
-        a, start = self.max_acceleration, self.speeds[leg]
+        a, start = self._limits(leg)[1], self.speeds[leg]
         peak, speeding, cruising, _ = (phase[leg] for phase in self._phases)
         reach = (peak ** 2 - start ** 2) / (2.0 * a)
         x = np.clip(distances, 0.0, self.lengths[leg])
@@ -134,7 +141,7 @@ class SpeedProfile:
 
     def state_at(self, leg: int, seconds: float) -> LegState:
         """Return sigma's LegState seconds after leg's start (clamped to the leg)."""
-        a, start = self.max_acceleration, float(self.speeds[leg])
+        a, start = self._limits(leg)[1], float(self.speeds[leg])
         peak, speeding, cruising, braking = (float(phase[leg]) for phase in self._phases)
         t = min(max(seconds, 0.0), speeding + cruising + braking)
         if t < speeding:
@@ -161,28 +168,83 @@ def speed_profile(positions: np.ndarray, max_speed: float, max_acceleration: flo
     if not (max_speed > 0 and max_acceleration > 0):
         raise ValueError('max_speed and max_acceleration must be positive')
     lengths = leg_lengths(positions)
+    return _fastest(positions, lengths, np.full(len(lengths), float(max_speed)),
+                    np.full(len(lengths), float(max_acceleration)),
+                    np.full(positions.shape[1], float(jump)), float(max_speed),
+                    float(max_acceleration))
+
+
+def fleet_profile(positions: np.ndarray, max_speeds: np.ndarray,
+                  max_accelerations: np.ndarray, min_gap: float,
+                  stops: np.ndarray | None = None) -> SpeedProfile:
+    """
+    Return the fastest SpeedProfile of positions (V, k, d) for each robot's own limits.
+
+    Robot i moves u_ij w on leg j (|u_ij| <= 1 per unit of sigma), so it stays
+    within its max_speeds[i] and max_accelerations[i] (k,) where sigma's speed
+    w <= min_i max_speeds[i] / |u_ij| and |w'| <= min_i max_accelerations[i] / |u_ij|
+    (the robots that move on leg j); a corner where its u_i changes by
+    Delta_i caps w at its own corner_jump / Delta_i; at the breakpoints where
+    stops (V,) is true, w is 0 (every robot at rest). With every robot at the
+    plan's limits and no stops this is :func:`speed_profile` (doc/design.md
+    section 8).
+    """
+    max_speeds = np.asarray(max_speeds, dtype=float)
+    max_accelerations = np.asarray(max_accelerations, dtype=float)
+    if not (np.all(max_speeds > 0) and np.all(max_accelerations > 0)):
+        raise ValueError('every max_speed and max_acceleration must be positive')
+    lengths = leg_lengths(positions)
+    steps = np.linalg.norm(np.diff(positions, axis=0), axis=2)
+    with np.errstate(divide='ignore', invalid='ignore'):
+        rates = np.where(lengths[:, None] > 0, steps / lengths[:, None], 0.0)   # |u_ij|
+        leg_speeds = np.where(rates > 0, max_speeds / rates, np.inf).min(axis=1)
+        leg_accelerations = np.where(rates > 0, max_accelerations / rates,
+                                     np.inf).min(axis=1)
+    jumps = np.array([corner_jump(a, min_gap) for a in max_accelerations])
+    # a leg in which nothing moves has no limit; its value is never used
+    fallback = float(max_speeds.max()), float(max_accelerations.max())
+    leg_speeds = np.where(np.isfinite(leg_speeds), leg_speeds, fallback[0])
+    leg_accelerations = np.where(np.isfinite(leg_accelerations), leg_accelerations,
+                                 fallback[1])
+    return _fastest(positions, lengths, leg_speeds, leg_accelerations, jumps, leg_speeds,
+                    leg_accelerations, stops)
+
+
+def _fastest(positions: np.ndarray, lengths: np.ndarray, leg_speeds: np.ndarray,
+             leg_accelerations: np.ndarray, jumps: np.ndarray,
+             max_speed: float | np.ndarray,
+             max_acceleration: float | np.ndarray,
+             stops: np.ndarray | None = None) -> SpeedProfile:
+    """
+    Return the fastest SpeedProfile within per-leg limits (L,) and per-robot jumps (k,).
+
+    A breakpoint's speed is at most both adjacent legs' speed limits and, at a
+    corner, min_i jumps[i] / Delta_i (0 at stops (V,)); then a forward and a
+    backward pass.
+    """
     steps = np.diff(positions, axis=0)
     moving = np.flatnonzero(lengths > 0)
-    caps = np.full(len(positions), float(max_speed))
+    caps = np.minimum(np.concatenate([[np.inf], leg_speeds]),
+                      np.concatenate([leg_speeds, [np.inf]]))
     caps[[0, -1]] = 0.0
     if moving.size:
         caps[:moving[0] + 1] = 0.0
         caps[moving[-1] + 1:] = 0.0
         rates = steps[moving] / lengths[moving][:, None, None]
-        change = np.linalg.norm(np.diff(rates, axis=0), axis=2).max(axis=1)
+        change = np.linalg.norm(np.diff(rates, axis=0), axis=2)
         with np.errstate(divide='ignore', invalid='ignore'):
-            corner = np.where(change > 0, jump / change, np.inf)
+            corner = np.where(change > 0, jumps / change, np.inf).min(axis=1)
         for before, after, cap in zip(moving[:-1], moving[1:], corner):
             # every breakpoint from the end of one moving leg to the start of the next
             caps[before + 1:after + 1] = np.minimum(caps[before + 1:after + 1], cap)
-    speeds = caps.copy()
+    speeds = np.where(stops, 0.0, caps) if stops is not None else caps.copy()
     for leg in range(len(lengths)):
-        speeds[leg + 1] = min(speeds[leg + 1],
-                              np.sqrt(speeds[leg] ** 2 + 2 * max_acceleration * lengths[leg]))
+        speeds[leg + 1] = min(speeds[leg + 1], np.sqrt(
+            speeds[leg] ** 2 + 2 * leg_accelerations[leg] * lengths[leg]))
     for leg in range(len(lengths) - 1, -1, -1):
-        speeds[leg] = min(speeds[leg],
-                          np.sqrt(speeds[leg + 1] ** 2 + 2 * max_acceleration * lengths[leg]))
-    return SpeedProfile(lengths, speeds, float(max_speed), float(max_acceleration))
+        speeds[leg] = min(speeds[leg], np.sqrt(
+            speeds[leg + 1] ** 2 + 2 * leg_accelerations[leg] * lengths[leg]))
+    return SpeedProfile(lengths, speeds, max_speed, max_acceleration)
 
 
 def stamps(positions: np.ndarray, max_speed: float, max_acceleration: float,

@@ -29,6 +29,7 @@ for SETTLE seconds: a robot late behind the clock reaches its goal at speed,
 and one control step inside the tolerance would stop it centimetres beyond.
 """
 
+from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
@@ -40,6 +41,9 @@ from .tolerance import clock_rate
 
 # Longest step the clock takes at once (s): a stalled control loop does not jump ahead.
 MAX_STEP = 0.2
+# Control steps of the clock kept to find the plan time at which an old position was taken
+# (5 s at 20 Hz; odom_timeout declares older odometry stale).
+HISTORY = 100
 # Seconds every robot must stay at its goal (and final heading) before the run is finished.
 SETTLE = 0.5
 # Largest feed-forward gain: a robot that achieves a quarter of its commands is not helped.
@@ -66,11 +70,30 @@ class ExecutionSettings:
     yaw_rate_limit: float = 1.0         # rad/s, differential robots
     final_heading: bool = True          # differential robots end facing their last pose
     # 1/s: how fast each robot's feed-forward gain learns its lag along its reference; 0: off
-    feedforward_adaptation: float = 0.3
+    feedforward_adaptation: float = 1.0
+    # each robot's own speed (m/s) and acceleration (m/s^2) limits: one value, or one per
+    # robot in plan order; empty: the plan's. The clock's reference is timed for them.
+    max_speeds: tuple = ()
+    max_accelerations: tuple = ()
 
     def differential(self, robot_count: int) -> np.ndarray:
         """Return the (k,) mask of differential robots; ValueError if drive does not fit k."""
         return differential_mask(self.drive, robot_count)
+
+    def limits(self, robot_count: int) -> tuple[np.ndarray | None, np.ndarray | None]:
+        """Return (k,) max_speeds and max_accelerations (None: the plan's); ValueError on k."""
+        return (per_robot('max_speeds', self.max_speeds, robot_count),
+                per_robot('max_accelerations', self.max_accelerations, robot_count))
+
+
+def per_robot(name: str, values: tuple, robot_count: int) -> np.ndarray | None:
+    """Return values (one, or one per robot) as (k,), None for none; ValueError if not k."""
+    if not values:
+        return None
+    if len(values) not in (1, robot_count):
+        raise ValueError('%s has %d values for %d robots (one, or one per robot)'
+                         % (name, len(values), robot_count))
+    return np.broadcast_to(np.asarray(values, dtype=float), robot_count).copy()
 
 
 def differential_mask(drive: tuple, robot_count: int) -> np.ndarray:
@@ -97,6 +120,23 @@ class Step:
     yaw_rates: np.ndarray       # (k,) differential robots' yaw rates (rad/s), else 0
 
 
+def behind(lags: np.ndarray, motion: np.ndarray) -> np.ndarray:
+    """
+    Return the (k,) parts of lags (reference - position, (k, 3)) that a slower clock reduces.
+
+    A robot behind its reference moving along motion (k, 3), or beside it, is
+    helped by the clock waiting: its whole lag counts. A robot ahead of it is
+    not (the reference catches up only while the clock runs, and a hold makes
+    a robot at speed overshoot further): only its sideways part counts. A
+    reference standing still: the whole lag.
+    """
+    speeds = np.linalg.norm(motion, axis=1)
+    along = np.einsum('kd,kd->k', lags, motion) / np.maximum(speeds, np.finfo(float).tiny)
+    distance = np.linalg.norm(lags, axis=1)
+    sideways = np.sqrt(np.maximum(distance ** 2 - along ** 2, 0.0))
+    return np.where((speeds > 0) & (along < 0), sideways, distance)
+
+
 def saturate(velocities: np.ndarray, limit: float | np.ndarray) -> np.ndarray:
     """Return (k, 3) velocities scaled down to speed at most limit, direction kept."""
     speeds = np.linalg.norm(velocities, axis=-1, keepdims=True)
@@ -109,19 +149,41 @@ class Execution:
 
     def __init__(self, reference: Reference, tolerance: float, settings: ExecutionSettings,
                  bodies: Bodies | None = None):
-        """Start at plan time 0 with no error measured yet; ValueError if drive does not fit."""
-        self.reference = reference
+        """
+        Start at plan time 0 with no error measured yet; ValueError if drive does not fit.
+
+        With robots slower than the plan (settings.max_speeds, max_accelerations)
+        the clock runs on the plan retimed for them (Reference.retimed): its
+        plan time is then that timing's.
+        """
         self.tolerance = float(tolerance)
+        k = reference.robot_count
+        speeds, accelerations = settings.limits(k)
+        profile = reference.profile
+        plan_acceleration = np.full(k, profile.max_acceleration if profile else np.inf)
+        # (k,) each robot's acceleration limit as the clock's rise sees it
+        self.accelerations = (plan_acceleration if accelerations is None
+                              else np.minimum(accelerations, plan_acceleration))
+        self.differential = settings.differential(k)
+        # a timed plan stops where a differential robot must turn in place (its clock then
+        # holds with every robot at rest, doc/design.md section 13)
+        stops = (unicycle.Corners(reference.seconds, reference.positions).turns(
+            self.differential) if profile is not None else np.zeros(0, dtype=bool))
+        if speeds is not None or accelerations is not None or stops.any():
+            reference = reference.retimed(
+                np.full(k, np.inf) if speeds is None else speeds,
+                self.accelerations, 2.0 * self.tolerance, stops if stops.any() else None)
+        self.reference = reference
         self.settings = settings
         self.bodies = bodies if bodies is not None else Bodies()
         self.plan_time = 0.0
         self.max_errors = np.zeros(reference.robot_count)
         self.min_gap = np.inf
-        self.differential = settings.differential(reference.robot_count)
         self.lead = unicycle.lead(self.tolerance, settings.slow_fraction,
                                   settings.hold_fraction)
         self.steering = unicycle.steering(self.lead)
-        self.corners = unicycle.Corners(reference.seconds, reference.positions)
+        self.corners = unicycle.Corners(reference.seconds, reference.positions,
+                                        reference.at_rest() if profile is not None else None)
         self.final_yaws = unicycle.yaws(reference.orientation(reference.duration))
         self.turning = np.zeros(reference.robot_count, dtype=bool)
         # robots driving backward: their lead point is e behind, their 'heading' theta + pi
@@ -130,22 +192,32 @@ class Execution:
         # (k,) what each robot's feed-forward is multiplied by: 1 until it lags (_feedforward)
         self.feedforward_gains = np.ones(reference.robot_count)
         self.rate = 0.0        # the clock's last rate
+        self.commanded_speeds = np.zeros(reference.robot_count)  # (k,) the last commands' m/s
+        self.elapsed = 0.0     # seconds of control steps so far
+        # (elapsed, plan time read) at each of the last HISTORY steps, for old positions
+        self.clock_history: deque = deque(maxlen=HISTORY)
 
     def step(self, dt: float, positions: np.ndarray, stale: np.ndarray,
-             orientations: np.ndarray | None = None) -> Step:
+             orientations: np.ndarray | None = None, ages: np.ndarray | None = None) -> Step:
         """
         Advance by dt seconds for robot positions (k, 3) and stale flags (k,); return the Step.
 
         orientations (k, 4) are the robots' quaternions (None: identity); the
         differential robots' headings are their yaws. The positions of stale
-        robots are not used (their errors count as 0 this step).
+        robots are not used (their errors count as 0 this step). ages (k,) are
+        how old the positions are (s; None: fresh): each is compared with its
+        reference at the plan time of that instant (:meth:`_measured`), and
+        the clock counts what a robot may have moved since, beyond one control
+        step, as error (:meth:`_unseen`).
         """
         s = self.settings
         stale = np.asarray(stale, dtype=bool)
         k = self.reference.robot_count
         angles = (np.zeros(k) if orientations is None else unicycle.yaws(orientations))
-        reference_now = self.reference.position(self.plan_time)
-        errors = np.linalg.norm(reference_now - positions, axis=1)
+        self.elapsed += max(dt, 0.0)
+        self.clock_history.append((self.elapsed, self.plan_time))
+        measured_reference = self._measured(ages)
+        errors = np.linalg.norm(measured_reference - positions, axis=1)
         errors[stale] = 0.0
         self.max_errors = np.maximum(self.max_errors, errors)
         if not stale.any():
@@ -154,15 +226,19 @@ class Execution:
         dt = min(max(dt, 0.0), MAX_STEP)
         # An all-holonomic fleet (the default) needs none of the unicycle's work.
         unicycles = bool(self.differential.any())
-        watched, alpha = errors, np.zeros(k)
+        motion = self.reference.velocity(self.plan_time)
+        watched, alpha = behind(measured_reference - positions, motion), np.zeros(k)
         if unicycles:
             # the clock watches each differential robot's bound E of its centre error
             lead_points = unicycle.lead_points(positions, self._driving(angles), self.lead)
-            watched = np.where(differential,
-                               np.linalg.norm(reference_now - lead_points, axis=1)
-                               + self.lead, errors)
+            bound = np.linalg.norm(measured_reference - lead_points, axis=1) + self.lead
+            watched = np.where(differential, bound, errors)
             alpha = self._update_turns(angles, watched)
+            watched = np.where(differential,
+                               behind(measured_reference - lead_points, motion) + self.lead,
+                               watched)
         driving = self._driving(angles)
+        watched = watched + self._unseen(ages, dt)
         if not s.shared_clock:
             rate = 1.0
         elif stale.any():
@@ -175,7 +251,7 @@ class Execution:
         duration = self.reference.duration
         self.plan_time = min(duration, self.plan_time + rate * dt)
         target = self.reference.position(self.plan_time)
-        feedforward = self._feedforward(rate, dt, reference_now - positions, stale)
+        feedforward = self._feedforward(rate, dt, measured_reference - positions, stale)
         command = feedforward + s.gain * (target - positions)
         velocities = saturate(command, s.speed_limit)
         forward, yaw_rates = np.zeros(k), np.zeros(k)
@@ -187,27 +263,67 @@ class Execution:
             velocities = np.where(differential[:, None],
                                   forward[:, None] * unicycle.headings(angles), velocities)
         velocities[stale] = 0.0
+        self.commanded_speeds = np.where(differential, np.abs(forward),
+                                         np.linalg.norm(velocities, axis=1))
         arrived = bool(self.plan_time >= duration and not stale.any() and np.all(
             np.linalg.norm(target - positions, axis=1) <= s.goal_tolerance))
         finished = self._settled(arrived, angles, dt) and arrived
         return Step(self.plan_time, rate, target, self.reference.orientation(self.plan_time),
                     velocities, errors, finished, self.differential.copy(), forward, yaw_rates)
 
+    def _measured(self, ages: np.ndarray | None) -> np.ndarray:
+        """
+        Return the (k, 3) references at the plan times the robots' positions were taken at.
+
+        A position ages (k,) seconds old (by arrival: an upper bound of its age)
+        is compared with its reference at the clock of that instant, from the
+        clock's last HISTORY steps (older: the oldest kept): a robot exactly on
+        its reference 0.3 s ago is not 0.3 s x v behind it. The certificate
+        needs every robot within delta of its reference at one and the same
+        plan time, which is what this compares; without ages (or 0) it is the
+        current plan time.
+        """
+        if ages is None or not np.any(np.asarray(ages) > 0):
+            return self.reference.position(self.plan_time)
+        times, plan_times = np.array(self.clock_history).T
+        then = np.interp(self.elapsed - np.asarray(ages, dtype=float), times, plan_times)
+        result = np.empty((self.reference.robot_count, 3))
+        for s_then in np.unique(then):
+            robots = then == s_then
+            result[robots] = self.reference.position(float(s_then))[robots]
+        return result
+
+    def _unseen(self, ages: np.ndarray | None, dt: float) -> np.ndarray:
+        """
+        Return the (k,) distances the robots may have moved since their odometry, beyond dt.
+
+        A robot whose odometry is a seconds old has moved about a x its speed
+        since (its last command's speed): at 0.5 m/s a stalled simulator's
+        0.5 s is 0.25 m, more than delta. One control step of age is the
+        sampling the margin (1 - hold_fraction) delta covers already; the rest
+        counts as tracking error, so the clock slows and holds while the
+        positions it sees are old (doc/design.md section 13).
+        """
+        if ages is None:
+            return np.zeros(self.reference.robot_count)
+        return np.maximum(np.asarray(ages, dtype=float) - dt, 0.0) * self.commanded_speeds
+
     def _rate_rise(self, wanted: float, dt: float) -> float:
         """
         Return wanted, or less where the clock would speed up faster than the plan allows.
 
-        Under the plan's acceleration limit a, the clock rises no faster than
-        lets the fastest reference's velocity rate x r'(s) grow by a dt: released
-        from a hold at once, every robot limited to a would lag its reference's
-        jump by up to v^2 / (2 a) and hold the clock again. It still slows and
-        holds at once. A plan without the limit keeps the clock's rate as it is.
+        Under acceleration limits a_i (the plan's, or each robot's own) the
+        clock rises no faster than lets every reference's velocity rate x r_i'(s)
+        grow by a_i dt: released from a hold at once, a robot limited to a_i
+        would lag its reference's jump by up to v^2 / (2 a_i) and hold the
+        clock again. It still slows and holds at once. A plan without the
+        limit keeps the clock's rate as it is.
         """
-        profile = self.reference.profile
-        if profile is None:
+        if self.reference.profile is None:
             return wanted
-        speed = float(np.linalg.norm(self.reference.velocity(self.plan_time), axis=1).max())
-        return min(wanted, self.rate + profile.max_acceleration * dt / max(speed, ADAPT_SPEED))
+        speeds = np.linalg.norm(self.reference.velocity(self.plan_time), axis=1)
+        rise = float(np.min(self.accelerations / np.maximum(speeds, ADAPT_SPEED)))
+        return min(wanted, self.rate + rise * dt)
 
     def _feedforward(self, rate: float, dt: float, lags: np.ndarray,
                      stale: np.ndarray) -> np.ndarray:
@@ -224,6 +340,8 @@ class Execution:
         toward 1 while it is ahead: a robot that achieves only a fraction f of
         its commands gets about 1 / f of the feed-forward and keeps the pace
         the clock sets instead of the much lower K e of its feedback alone.
+        A gain does not grow while its feed-forward alone reaches the speed
+        limit (anti-windup: the robot cannot go faster).
         With the clock held (rate 0) there is no feed-forward, so the hold's
         argument (doc/design.md section 13) is unchanged.
         """
@@ -235,6 +353,11 @@ class Execution:
         along = np.einsum('kd,kd->k', lags, velocity) / np.maximum(speeds, ADAPT_SPEED)
         waited = self.settings.slow_fraction * self.tolerance
         excess = np.where(along > waited, along - waited, np.minimum(along, 0.0))
+        # no growth while the feed-forward alone is at the speed limit: a larger gain would
+        # not move the robot faster, only wind up (and overshoot once the reference slows)
+        saturated = (self.feedforward_gains * np.linalg.norm(feedforward, axis=1)
+                     >= self.settings.speed_limit)
+        excess = np.where(saturated, np.minimum(excess, 0.0), excess)
         change = self.settings.feedforward_adaptation * dt * excess / self.tolerance
         self.feedforward_gains = np.clip(
             np.where(moving, self.feedforward_gains + change, self.feedforward_gains),

@@ -13,13 +13,17 @@ moves along the same segments, but its speed follows the profile the stamps
 were made with (doc/design.md section 8): :meth:`Reference.timed` rebuilds it
 from the poses, each interval stretched to its stamps, so the poses stay
 exact at their stamps; velocity and acceleration are then its derivatives.
+
+:meth:`Reference.retimed` times the same motion for robots slower than the
+plan's limits (each robot's own speed and acceleration): a common
+reparameterisation of time, so every certificate of the plan still holds.
 """
 
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.timing import corner_jump, speed_profile, SpeedProfile
+from ..core.timing import corner_jump, fleet_profile, speed_profile, SpeedProfile
 
 
 @dataclass(frozen=True)
@@ -45,6 +49,36 @@ class Reference:
         return cls(seconds, positions, orientations,
                    speed_profile(positions, max_speed, max_acceleration,
                                  corner_jump(max_acceleration, min_gap)))
+
+    def retimed(self, max_speeds: np.ndarray, max_accelerations: np.ndarray,
+                min_gap: float, stops: np.ndarray | None = None) -> 'Reference':
+        """
+        Return the same motion timed so that robot i needs at most its own limits (k,).
+
+        No robot faster than the plan: each limit is taken at most the plan's.
+        A plan stamped without an acceleration limit keeps linear intervals,
+        each at least as long as its slowest robot's move at max_speeds[i];
+        one stamped under a limit gets :func:`fleet_profile`'s stamps, at rest
+        at the poses where stops (M,) is true (doc/design.md section 8; a plan
+        without the limit has no rest inside). Orientations stay with their poses.
+        """
+        speeds = np.asarray(max_speeds, dtype=float)
+        if self.profile is None:
+            moves = np.linalg.norm(np.diff(self.positions, axis=0), axis=2)
+            slowest = (moves / speeds).max(axis=1, initial=0.0)
+            durations = np.maximum(np.diff(self.seconds), slowest)
+            return Reference(np.concatenate([[0.0], np.cumsum(durations)]), self.positions,
+                             self.orientations)
+        profile = fleet_profile(self.positions, np.minimum(speeds, self.profile.max_speed),
+                                np.minimum(max_accelerations, self.profile.max_acceleration),
+                                min_gap, stops)
+        return Reference(profile.stamps(), self.positions, self.orientations, profile)
+
+    def at_rest(self) -> np.ndarray:
+        """Return the (M,) poses at which the reference stands still (its profile's w = 0)."""
+        if self.profile is None:
+            return np.zeros(self.seconds.size, dtype=bool)
+        return self.profile.speeds == 0
 
     @property
     def duration(self) -> float:

@@ -171,9 +171,17 @@ def creep_rate(angles: np.ndarray, speeds: np.ndarray, steering_length: float,
 class Corners:
     """A reference's moving intervals per robot, for the turns ahead of the clock."""
 
-    def __init__(self, seconds: np.ndarray, positions: np.ndarray):
-        """Precompute each interval's velocity and each robot's next moving interval."""
+    def __init__(self, seconds: np.ndarray, positions: np.ndarray,
+                 rests: np.ndarray | None = None):
+        """
+        Precompute each interval's velocity and each robot's next moving interval.
+
+        rests (M,): the poses at which a reference timed under acceleration
+        limits stands still (Reference.at_rest); None: a plan without the limit,
+        whose velocities jump at every corner.
+        """
         self.seconds = np.asarray(seconds, dtype=float)
+        self.rests = rests
         lengths = np.diff(self.seconds)
         steps = np.diff(positions, axis=0)
         with np.errstate(divide='ignore', invalid='ignore'):
@@ -186,6 +194,22 @@ class Corners:
         # next_moving[j, i]: first interval >= j in which robot i moves (count: none)
         index = np.where(moving, np.arange(count)[:, None], count)
         self.next_moving = np.minimum.accumulate(index[::-1], axis=0)[::-1] if count else index
+
+    def turns(self, robots: np.ndarray) -> np.ndarray:
+        """
+        Return the (M,) poses at which one of robots (k,) turns by more than TURN_ANGLE.
+
+        Between two consecutive moves of a robot (the intervals between them
+        may stand still), at the start of the second one: there it turns in
+        place or switches its driving direction.
+        """
+        result = np.zeros(self.seconds.size, dtype=bool)
+        for robot in np.flatnonzero(robots):
+            moves = np.flatnonzero(self.speeds[:, robot] > STILL)
+            directions = self.velocities[moves, robot]
+            beta = wrap(np.diff(np.arctan2(directions[:, 1], directions[:, 0])))
+            result[moves[1:][np.abs(beta) > TURN_ANGLE]] = True
+        return result
 
     def interval(self, s: float) -> int:
         """Return the index of the interval holding plan time s (its last one from the end)."""
@@ -222,7 +246,10 @@ class Corners:
         a base with an acceleration limit cannot stop at once either. It must be
         passed at most at creep_rate(beta) (CORNER_RATE if beta needs a turn in
         place or the reference stops), and the cap rises linearly to 1 over
-        LOOKAHEAD plan seconds before it.
+        LOOKAHEAD plan seconds before it. A reference timed under acceleration
+        limits (rests) brakes into its stops at those limits, and its turns
+        beyond TURN_ANGLE are stops (Execution): there only the creep corners
+        are left to slow into.
         """
         k = self.speeds.shape[1] if self.speeds.size else 0
         caps = np.ones(k)
@@ -233,6 +260,8 @@ class Corners:
             after = self.velocities[b] if b < len(self.speeds) else np.zeros_like(before)
             speeds_after = np.linalg.norm(after, axis=-1)
             corner = self.speeds[b - 1] > STILL
+            if self.rests is not None:
+                corner &= (speeds_after > STILL) & ~self.rests[b]
             if not corner.any():
                 continue
             beta = wrap(np.arctan2(after[:, 1], after[:, 0])

@@ -13,8 +13,9 @@ linear.x and angular.z, linear.y exactly 0) and ``<robot>/reference_pose``
 
 Goal life: the plan is looked up (``NO_PLAN`` once ``PLAN_WAIT_SEC`` passed
 without it: the planner answers before it publishes, so a goal may name a plan
-still on its way), its tolerance checked (``UNSAFE_PLAN``), ``drive`` checked
-against its robots (``UNKNOWN_ROBOTS``: neither one value nor one per robot);
+still on its way), its tolerance checked (``UNSAFE_PLAN``), ``drive``,
+``max_speeds`` and ``max_accelerations`` checked against its robots
+(``UNKNOWN_ROBOTS``: neither one value nor one per robot);
 the executor then waits up to ``discovery_timeout`` for
 fresh odometry of every robot (``UNKNOWN_ROBOTS``) in the plan's frame
 (``FRAME_MISMATCH``); then it runs until every robot has arrived (``NONE``),
@@ -184,7 +185,7 @@ class PlanExecutor(Node):
             found = await self._wait_for_plan(goal.request.plan_id)
         run = None
         if found.code == Result.NONE:
-            found = self._check_drive(found)
+            found = self._check_per_robot(found)
         if found.code == Result.NONE:
             run = Run(goal, found.plan, self.get_clock().now().nanoseconds)
             self._run = run
@@ -223,10 +224,16 @@ class PlanExecutor(Node):
             self._plan_waits.remove(entry)
         return self._plans.lookup(plan_id, self.resolve_topic_name('plan'))
 
-    def _check_drive(self, found: Lookup) -> Lookup:
-        """Return found, or UNKNOWN_ROBOTS when drive has neither one value nor one per robot."""
+    def _check_per_robot(self, found: Lookup) -> Lookup:
+        """
+        Return found, or UNKNOWN_ROBOTS when drive has neither one value nor one per robot.
+
+        The same for max_speeds and max_accelerations (which may also be empty).
+        """
+        settings, count = self._settings.execution, len(found.plan.names)
         try:
-            differential_mask(self._settings.drive, len(found.plan.names))
+            differential_mask(settings.drive, count)
+            settings.limits(count)
         except ValueError as error:
             return Lookup(found.plan, Result.UNKNOWN_ROBOTS, 'plan %d has robots %s: %s'
                           % (found.plan.plan_id, ', '.join(found.plan.names), error))
@@ -280,12 +287,12 @@ class PlanExecutor(Node):
         if self._hold_expired(run, state, now):
             return
         step = run.execution.step((now - run.last_ns) * 1e-9, state.positions,
-                                  state.stale_mask, state.orientations)
+                                  state.stale_mask, state.orientations, state.ages)
         run.last_ns = now
         self._log_stale(run, state, step.plan_time)
         self._publish_step(plan, step, state, now)
         run.goal.publish_feedback(ExecutePlan.Feedback(
-            plan_time=step.plan_time, plan_duration=plan.reference.duration,
+            plan_time=step.plan_time, plan_duration=run.execution.reference.duration,
             clock_rate=step.rate, max_tracking_errors=run.execution.max_errors.tolist(),
             min_gap=float(run.execution.min_gap), stale_robots=list(state.stale)))
         if step.finished:
@@ -305,8 +312,10 @@ class PlanExecutor(Node):
         run.execution = Execution(plan.reference, plan.tolerance, settings.execution,
                                   plan.bodies)
         run.started_ns = run.last_ns = now
-        self.get_logger().info('executing plan %d: %d robots, %.3f s'
-                               % (plan.plan_id, len(plan.names), plan.reference.duration))
+        self.get_logger().info('executing plan %d: %d robots, %.3f s (%.3f s as timed for '
+                               'the robots)' % (plan.plan_id, len(plan.names),
+                                                plan.reference.duration,
+                                                run.execution.reference.duration))
         return True
 
     def _hold_expired(self, run: Run, state: FleetState, now: int) -> bool:

@@ -82,7 +82,8 @@ class FleetState:
     The robots of a plan at one control step.
 
     positions (k, 3) and orientations (k, 4) (a stale robot keeps the plan's
-    start and the identity), the stale robots' names and (k,) mask, and
+    start and the identity), the stale robots' names and (k,) mask, the (k,)
+    ages of the odometry by arrival (s; 0 for a stale robot) and
     ``wrong_frame``: why some odometry is in another frame than the plan's
     ('' when none is).
     """
@@ -91,6 +92,7 @@ class FleetState:
     orientations: np.ndarray
     stale: tuple
     stale_mask: np.ndarray
+    ages: np.ndarray
     wrong_frame: str = ''
 
 
@@ -102,6 +104,7 @@ def fleet_state(plan: KnownPlan, odometry: dict[str, RobotOdometry], now_ns: int
     orientations = np.tile([0.0, 0.0, 0.0, 1.0], (k, 1))
     stale = []
     wrong_frame = ''
+    ages = np.zeros(k)
     for i, name in enumerate(plan.names):
         entry = odometry.get(name)
         if entry is None or now_ns - entry.received_ns > timeout_sec * 1e9:
@@ -113,5 +116,6 @@ def fleet_state(plan: KnownPlan, odometry: dict[str, RobotOdometry], now_ns: int
             break
         positions[i] = entry.position
         orientations[i] = entry.orientation
+        ages[i] = (now_ns - entry.received_ns) * 1e-9
     mask = np.array([name in stale for name in plan.names])
-    return FleetState(positions, orientations, tuple(stale), mask, wrong_frame)
+    return FleetState(positions, orientations, tuple(stale), mask, ages, wrong_frame)

@@ -273,11 +273,23 @@ class ExecutorSettings:
         "orientation of its last pose (the request's; identity faces +x); 'none': it "
         'stops facing where it arrived.', choices=('request', 'none')).field()
     feedforward_adaptation: float = Spec(
-        'feedforward_adaptation', 'double', 0.3,
+        'feedforward_adaptation', 'double', 1.0,
         "How fast (1/s) each robot's feed-forward gain grows while it lags behind its "
         'moving reference by more than slow_fraction of the tolerance (and falls back '
         'toward 1 while it is ahead), up to 4: a robot that achieves a fraction f of its '
         'commands gets about 1/f of the feed-forward; 0: off.', low=0.0, high=100.0).field()
+    max_speeds: tuple = Spec(
+        'max_speeds', 'double_array', [],
+        "Each robot's own top speed (m/s), one value for all or one per robot in plan "
+        "order; empty: the plan's max_speed. The clock runs on the plan retimed so that no "
+        "robot's reference is faster than its own (none faster than the plan).",
+        check=within(1e-6, 1e3), prose='empty, one, or one per robot, in [1e-06, 1000]').field()
+    max_accelerations: tuple = Spec(
+        'max_accelerations', 'double_array', [],
+        "Each robot's own acceleration limit (m/s^2), one value for all or one per robot; "
+        "empty: the plan's max_acceleration. Retimes a plan stamped under an acceleration "
+        'limit like max_speeds.', check=within(1e-6, 1e3),
+        prose='empty, one, or one per robot, in [1e-06, 1000]').field()
 
     @property
     def execution(self) -> ExecutionSettings:
@@ -289,7 +301,9 @@ class ExecutorSettings:
                                  shared_clock=self.shared_clock == 'on', drive=self.drive,
                                  yaw_rate_limit=self.yaw_rate_limit,
                                  final_heading=self.final_heading == 'request',
-                                 feedforward_adaptation=self.feedforward_adaptation)
+                                 feedforward_adaptation=self.feedforward_adaptation,
+                                 max_speeds=self.max_speeds,
+                                 max_accelerations=self.max_accelerations)
 
 
 def _slow_below_hold(settings: ExecutorSettings) -> None:
