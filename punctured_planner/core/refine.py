@@ -69,8 +69,9 @@ PAIR_SHARE, PILLAR_SHARE = 0.25, 0.5
 # weaker, for nothing but rounding).
 _TRANSLATION = 4.0
 # Entries (coordinate x leg x robot x robot or pillar) of the slack arrays computed at
-# once.
-_ENTRIES = 1 << 21
+# once: a few hundred kB stay in cache (with 1 << 21, megabytes per pass, the caps of a
+# 40-robot plan took about 1.5x as long).
+_ENTRIES = 1 << 15
 
 
 @dataclass(frozen=True, eq=False)
