@@ -72,6 +72,11 @@ _TRANSLATION = 4.0
 # once: a few hundred kB stay in cache (with 1 << 21, megabytes per pass, the caps of a
 # 40-robot plan took about 1.5x as long).
 _ENTRIES = 1 << 15
+# The robot-pair filter's allowance for rounding, as a share of the coordinate scale: the
+# closed form and the bounds each round to a few ulps of it, 1e5 times less.
+_BOUND_SLACK = 1e-9
+# Coordinates up to this size are filtered; beyond, squares could overflow.
+_FILTERED_SCALE = 1e150
 
 
 @dataclass(frozen=True, eq=False)
@@ -196,6 +201,43 @@ def _interval_boxes(planes, points):
     return low, high
 
 
+def _planes_length(planes):
+    """Return the lengths (...) of coordinate-first vectors (d, ...)."""
+    squared = planes[0] * planes[0]
+    for axis in range(1, planes.shape[0]):
+        squared += planes[axis] * planes[axis]
+    return np.sqrt(squared)
+
+
+def _pair_minimum(values, a, b, k):
+    """Return (..., k) each robot's smallest value over its pairs (a, b) of values (..., pairs)."""
+    matrix = np.full(values.shape[:-1] + (k, k), np.inf)
+    matrix[..., a, b] = values
+    matrix[..., b, a] = values
+    return matrix.min(axis=-1)
+
+
+def _near_pairs(piece, starts, a, b, margin):
+    """
+    Return the pairs (indices into a, b) that can hold a robot's smallest distance in a run.
+
+    piece (d, V, k) is the run's breakpoints, starts its intervals' first
+    breakpoints in it. Each robot comes within its nearest partner's distance
+    at one of those knots in each interval (plus margin, far above rounding);
+    a pair whose boxes over the run stay farther apart than that for both of
+    its robots is never the smallest of either, so the pairs kept give every
+    robot's very minimum.
+    """
+    knots = piece[:, starts]
+    near = _pair_minimum(_planes_length(np.take(knots, a, axis=2) - np.take(knots, b, axis=2)),
+                         a, b, piece.shape[2]).max(axis=0) + margin
+    low, high = piece.min(axis=1), piece.max(axis=1)
+    gap = np.maximum(np.take(low, a, axis=1) - np.take(high, b, axis=1),
+                     np.take(low, b, axis=1) - np.take(high, a, axis=1))
+    np.maximum(gap, 0.0, out=gap)
+    return np.flatnonzero(_planes_length(gap) - margin <= np.maximum(near[a], near[b]))
+
+
 def _interval_minima(planes, knots, pillars=None):
     """
     Return (N - 1, k, m) the exact smallest distance over each knot interval, densely.
@@ -205,28 +247,37 @@ def _interval_minima(planes, knots, pillars=None):
     the minimum over each interval's legs. planes is the motion coordinate
     first (d, U, k). Dense arrays over a few hundred legs cost less than
     choosing pairs would; a run of whole intervals at a time bounds the
-    temporaries (the grouping does not change any value).
+    temporaries (the grouping does not change any value). Robot pairs too far
+    apart over a run to be any robot's nearest (_near_pairs) are left at +inf:
+    every robot's smallest distance, all the caps use, stays the same.
     """
     d, _, k = planes.shape
     # Robot pairs a < b only (np.take keeps the pairs last and contiguous), then mirrored.
     a, b = np.triu_indices(k, 1)
     width = a.size if pillars is None else k * pillars.shape[0]
     points = knots.points
-    minima = np.empty((points.size - 1, width))
+    minima = np.full((points.size - 1, width), np.inf)
     legs = max(1, _ENTRIES // (d * max(width, 1)))
+    scale = float(np.abs(planes).max(initial=0.0))
+    # Squares this large could overflow (inf, nan), which the filter must not drop.
+    filtered = pillars is None and scale < _FILTERED_SCALE
     first = 0
     while first < minima.shape[0]:
         last = int(np.searchsorted(points, points[first] + legs, side='right')) - 1
         last = min(max(last, first + 1), minima.shape[0])
         piece = planes[:, points[first]:points[last] + 1]
-        if pillars is None:
-            relative = np.take(piece, a, axis=2) - np.take(piece, b, axis=2)
-        else:
+        starts = points[first:last] - points[first]
+        kept: slice | np.ndarray
+        if pillars is not None:
             relative = (piece[:, :, :, None] - pillars.T[:, None, None, :]).reshape(
                 d, piece.shape[1], width)
+            kept = slice(None)
+        else:
+            kept = (_near_pairs(piece, starts, a, b, _BOUND_SLACK * scale) if filtered
+                    else np.arange(a.size))
+            relative = np.take(piece, a[kept], axis=2) - np.take(piece, b[kept], axis=2)
         squared, _ = segment_minimum(relative[:, :-1], relative[:, 1:] - relative[:, :-1])
-        minima[first:last] = np.sqrt(np.minimum.reduceat(
-            squared, points[first:last] - points[first], axis=0))
+        minima[first:last, kept] = np.sqrt(np.minimum.reduceat(squared, starts, axis=0))
         first = last
     if pillars is not None:
         return minima.reshape(minima.shape[0], k, pillars.shape[0])
