@@ -77,6 +77,8 @@ _ENTRIES = 1 << 15
 _BOUND_SLACK = 1e-9
 # Coordinates up to this size are filtered; beyond, squares could overflow.
 _FILTERED_SCALE = 1e150
+# Entries (coordinate x knot x robot pair) of the filter's arrays computed at once.
+_FILTER_ENTRIES = 1 << 17
 
 
 @dataclass(frozen=True, eq=False)
@@ -217,25 +219,44 @@ def _pair_minimum(values, a, b, k):
     return matrix.min(axis=-1)
 
 
-def _near_pairs(piece, starts, a, b, margin):
-    """
-    Return the pairs (indices into a, b) that can hold a robot's smallest distance in a run.
+def _runs(points, legs):
+    """Return [(first, last), ...]: runs of whole knot intervals of about legs legs each."""
+    runs, first, intervals = [], 0, points.size - 1
+    while first < intervals:
+        last = int(np.searchsorted(points, points[first] + legs, side='right')) - 1
+        last = min(max(last, first + 1), intervals)
+        runs.append((first, last))
+        first = last
+    return runs
 
-    piece (d, V, k) is the run's breakpoints, starts its intervals' first
-    breakpoints in it. Each robot comes within its nearest partner's distance
-    at one of those knots in each interval (plus margin, far above rounding);
-    a pair whose boxes over the run stay farther apart than that for both of
-    its robots is never the smallest of either, so the pairs kept give every
-    robot's very minimum.
+
+def _near_pairs(planes, points, runs, a, b, margin):
     """
-    knots = piece[:, starts]
-    near = _pair_minimum(_planes_length(np.take(knots, a, axis=2) - np.take(knots, b, axis=2)),
-                         a, b, piece.shape[2]).max(axis=0) + margin
-    low, high = piece.min(axis=1), piece.max(axis=1)
-    gap = np.maximum(np.take(low, a, axis=1) - np.take(high, b, axis=1),
-                     np.take(low, b, axis=1) - np.take(high, a, axis=1))
+    Return (runs, pairs) whether each pair can hold a robot's smallest distance in each run.
+
+    In every interval each robot comes within its nearest partner's distance at
+    the interval's first knot (plus margin, far above rounding); a pair whose
+    boxes over the run stay farther apart than the largest of those for both
+    of its robots is never the smallest of either, so the pairs kept give
+    every robot's very minimum.
+    """
+    firsts = np.array([first for first, _ in runs])
+    lasts = np.array([last for _, last in runs])
+    knots = planes[:, points[firsts[0]:lasts[-1]]]
+    nearest = _pair_minimum(
+        _planes_length(np.take(knots, a, axis=2) - np.take(knots, b, axis=2)), a, b,
+        planes.shape[2])
+    near = np.maximum.reduceat(nearest, firsts - firsts[0], axis=0) + margin
+    begins, ends = points[firsts], points[lasts]
+    piece = planes[:, begins[0]:ends[-1] + 1]
+    # The motion is linear between breakpoints: their box over a run holds all of it.
+    low = np.minimum(np.minimum.reduceat(piece, begins - begins[0], axis=1), planes[:, ends])
+    high = np.maximum(np.maximum.reduceat(piece, begins - begins[0], axis=1), planes[:, ends])
+    gap = np.maximum(np.take(low, a, axis=2) - np.take(high, b, axis=2),
+                     np.take(low, b, axis=2) - np.take(high, a, axis=2))
     np.maximum(gap, 0.0, out=gap)
-    return np.flatnonzero(_planes_length(gap) - margin <= np.maximum(near[a], near[b]))
+    return _planes_length(gap) - margin <= np.maximum(np.take(near, a, axis=1),
+                                                      np.take(near, b, axis=1))
 
 
 def _interval_minima(planes, knots, pillars=None):
@@ -257,14 +278,17 @@ def _interval_minima(planes, knots, pillars=None):
     width = a.size if pillars is None else k * pillars.shape[0]
     points = knots.points
     minima = np.full((points.size - 1, width), np.inf)
-    legs = max(1, _ENTRIES // (d * max(width, 1)))
+    runs = _runs(points, max(1, _ENTRIES // (d * max(width, 1))))
     scale = float(np.abs(planes).max(initial=0.0))
     # Squares this large could overflow (inf, nan), which the filter must not drop.
-    filtered = pillars is None and scale < _FILTERED_SCALE
-    first = 0
-    while first < minima.shape[0]:
-        last = int(np.searchsorted(points, points[first] + legs, side='right')) - 1
-        last = min(max(last, first + 1), minima.shape[0])
+    near = np.ones((len(runs), a.size), dtype=bool)
+    if pillars is None and scale < _FILTERED_SCALE:
+        # The filter's arrays for a batch of runs: about _FILTER_ENTRIES entries.
+        batch = max(1, _FILTER_ENTRIES * len(runs) // (d * (points.size - 1) * max(a.size, 1)))
+        for run in range(0, len(runs), batch):
+            near[run:run + batch] = _near_pairs(planes, points, runs[run:run + batch], a, b,
+                                                _BOUND_SLACK * scale)
+    for run, (first, last) in enumerate(runs):
         piece = planes[:, points[first]:points[last] + 1]
         starts = points[first:last] - points[first]
         kept: slice | np.ndarray
@@ -273,12 +297,10 @@ def _interval_minima(planes, knots, pillars=None):
                 d, piece.shape[1], width)
             kept = slice(None)
         else:
-            kept = (_near_pairs(piece, starts, a, b, _BOUND_SLACK * scale) if filtered
-                    else np.arange(a.size))
+            kept = np.flatnonzero(near[run])
             relative = np.take(piece, a[kept], axis=2) - np.take(piece, b[kept], axis=2)
         squared, _ = segment_minimum(relative[:, :-1], relative[:, 1:] - relative[:, :-1])
         minima[first:last, kept] = np.sqrt(np.minimum.reduceat(squared, starts, axis=0))
-        first = last
     if pillars is not None:
         return minima.reshape(minima.shape[0], k, pillars.shape[0])
     result = np.full((minima.shape[0], k, k), np.inf)
