@@ -259,18 +259,42 @@ def _near_pairs(planes, points, runs, a, b, margin):
                                                       np.take(near, b, axis=1))
 
 
-def _interval_minima(planes, knots, pillars=None):
+def _near_pillars(planes, points, runs, pillars, offsets, margin):
+    """
+    Return (runs, k r) whether each robot-pillar pair can hold a robot's smallest slack.
+
+    _near_pairs for pillars (r, d): the slack is the distance less offsets (k, r);
+    each robot keeps its smallest at an interval's first knot (plus margin).
+    """
+    firsts = np.array([first for first, _ in runs])
+    lasts = np.array([last for _, last in runs])
+    centres = pillars.T[:, None, None, :]
+    knots = planes[:, points[firsts[0]:lasts[-1]], :, None]
+    nearest = (_planes_length(knots - centres) - offsets).min(axis=2)
+    near = np.maximum.reduceat(nearest, firsts - firsts[0], axis=0) + margin
+    begins, ends = points[firsts], points[lasts]
+    piece = planes[:, begins[0]:ends[-1] + 1]
+    low = np.minimum(np.minimum.reduceat(piece, begins - begins[0], axis=1), planes[:, ends])
+    high = np.maximum(np.maximum.reduceat(piece, begins - begins[0], axis=1), planes[:, ends])
+    gap = np.maximum(low[..., None] - centres, centres - high[..., None])
+    np.maximum(gap, 0.0, out=gap)
+    keep = _planes_length(gap) - offsets - margin <= near[:, :, None]
+    return keep.reshape(len(runs), -1)
+
+
+def _interval_minima(planes, knots, pillars=None, offsets=None):
     """
     Return (N - 1, k, m) the exact smallest distance over each knot interval, densely.
 
     From every robot to every robot (m = k, the diagonal +inf) or, with pillars
-    (m, d), to every pillar: the closed form on every leg of the union, then
-    the minimum over each interval's legs. planes is the motion coordinate
+    (m, d), to every pillar (whose caps take offsets (k, m) from the distance):
+    the closed form on every leg of the union, then the minimum over each
+    interval's legs. planes is the motion coordinate
     first (d, U, k). Dense arrays over a few hundred legs cost less than
     choosing pairs would; a run of whole intervals at a time bounds the
-    temporaries (the grouping does not change any value). Robot pairs too far
-    apart over a run to be any robot's nearest (_near_pairs) are left at +inf:
-    every robot's smallest distance, all the caps use, stays the same.
+    temporaries (the grouping does not change any value). Pairs too far apart
+    over a run to hold any robot's smallest (_near_pairs, _near_pillars) are
+    left at +inf: every robot's smallest, all the caps use, stays the same.
     """
     d, _, k = planes.shape
     # Robot pairs a < b only (np.take keeps the pairs last and contiguous), then mirrored.
@@ -279,25 +303,28 @@ def _interval_minima(planes, knots, pillars=None):
     points = knots.points
     minima = np.full((points.size - 1, width), np.inf)
     runs = _runs(points, max(1, _ENTRIES // (d * max(width, 1))))
-    scale = float(np.abs(planes).max(initial=0.0))
+    scale = max(float(np.abs(planes).max(initial=0.0)),
+                0.0 if pillars is None else float(np.abs(pillars).max(initial=0.0)))
+    near = np.ones((len(runs), width), dtype=bool)
     # Squares this large could overflow (inf, nan), which the filter must not drop.
-    near = np.ones((len(runs), a.size), dtype=bool)
-    if pillars is None and scale < _FILTERED_SCALE:
+    if scale < _FILTERED_SCALE:
         # The filter's arrays for a batch of runs: about _FILTER_ENTRIES entries.
-        batch = max(1, _FILTER_ENTRIES * len(runs) // (d * (points.size - 1) * max(a.size, 1)))
+        batch = max(1, _FILTER_ENTRIES * len(runs) // (d * (points.size - 1) * max(width, 1)))
         for run in range(0, len(runs), batch):
-            near[run:run + batch] = _near_pairs(planes, points, runs[run:run + batch], a, b,
-                                                _BOUND_SLACK * scale)
+            chosen = runs[run:run + batch]
+            margin = _BOUND_SLACK * scale
+            near[run:run + batch] = (
+                _near_pairs(planes, points, chosen, a, b, margin) if pillars is None else
+                _near_pillars(planes, points, chosen, pillars, offsets,
+                              margin + _BOUND_SLACK * float(np.abs(offsets).max())))
     for run, (first, last) in enumerate(runs):
         piece = planes[:, points[first]:points[last] + 1]
         starts = points[first:last] - points[first]
-        kept: slice | np.ndarray
+        kept = np.flatnonzero(near[run])
         if pillars is not None:
-            relative = (piece[:, :, :, None] - pillars.T[:, None, None, :]).reshape(
-                d, piece.shape[1], width)
-            kept = slice(None)
+            robot, pillar = np.divmod(kept, pillars.shape[0])
+            relative = np.take(piece, robot, axis=2) - pillars.T[:, None, pillar]
         else:
-            kept = np.flatnonzero(near[run])
             relative = np.take(piece, a[kept], axis=2) - np.take(piece, b[kept], axis=2)
         squared, _ = segment_minimum(relative[:, :-1], relative[:, 1:] - relative[:, :-1])
         minima[first:last, kept] = np.sqrt(np.minimum.reduceat(squared, starts, axis=0))
@@ -332,7 +359,8 @@ class _Caps:
         pillar = np.full((intervals, k), 2 * step)
         if len(bodies.obstacles):
             offsets = bodies.radii[:k, None] + bodies.radii[None, k:] + floor
-            slack = (_interval_minima(planes, knots, bodies.obstacles) - offsets).min(axis=2)
+            slack = (_interval_minima(planes, knots, bodies.obstacles, offsets)
+                     - offsets).min(axis=2)
             pillar = np.minimum(pillar, PILLAR_SHARE * np.maximum(slack, 0.0))
         self.pair, self.pillar = _knot_caps(pair), _knot_caps(pillar)
         self.lower = self.upper = self.inward = None
@@ -426,19 +454,23 @@ class _Block:
         return common, own
 
 
-def _sweep(start, common, own, base_knots, block):
+def _sweep(origin, common, own, block):
     """
     Return (common, own) after one red-black sweep of over-relaxed smoothing.
 
     Each knot moves RELAXATION x the way to its neighbours' midpoint, the move
     split into the fleet's mean and each robot's own part; knots of one parity
     have no neighbour of the same parity, so each half sweep uses the other
-    half's newest values.
+    half's newest values. origin is where the block starts: the construction's
+    knots plus the field so far, in that order.
     """
     for parity in (1, 0):
-        current = base_knots + start + common[:, None] + own
-        index = np.arange(parity + (1 - parity) * 2, current.shape[0] - 1, 2)
-        move = RELAXATION * (0.5 * (current[index - 1] + current[index + 1]) - current[index])
+        current = origin + common[:, None] + own
+        # The knots of this parity (slices: views, not gathers) and their two neighbours.
+        first = parity + (1 - parity) * 2
+        index = slice(first, current.shape[0] - 1, 2)
+        before, after = slice(first - 1, -2, 2), slice(first + 1, None, 2)
+        move = RELAXATION * (0.5 * (current[before] + current[after]) - current[index])
         wanted = common[:, None] + own
         wanted[index] += move
         common, own = block.clip(wanted)
@@ -487,8 +519,9 @@ def refine(times: np.ndarray, positions: np.ndarray, waypoint_indices: np.ndarra
         block = _Block(caps, step)
         common, own = ((np.zeros((values.shape[0], d)), np.zeros_like(values))
                        if caps.inward is None else block.clip(caps.inward))
+        origin = base_knots + values
         for _ in range(SWEEPS):
-            common, own = _sweep(values, common, own, base_knots, block)
+            common, own = _sweep(origin, common, own, block)
         values = values + common[:, None] + own
         # x + 0.0 is x: a robot held everywhere in an interval keeps x's breakpoints.
         motion = union.positions + knots.field(values)
