@@ -21,10 +21,11 @@ smallest robot-pillar slack; each knot's total move in the block is split into
 the fleet's common translation (which robot pairs do not feel) and each
 robot's own part, each clipped to its caps and to a fixed step. Gap distance
 is 1-Lipschitz in each robot's position, so no gap falls below g0 (the caps
-lemma). Every pair is evaluated, so no pair enters or leaves the checked set;
-every quantity is a continuous function of the input, and the number of
-blocks, sweeps and knots is fixed, so the map stays continuous on every domain
-(doc/design.md section 14).
+lemma). Every robot's smallest slack is over every pair (pairs that cannot
+hold it are skipped, exactly: the same values), so no pair enters or leaves
+the checked set; every quantity is a continuous function of the input, and
+the number of blocks, sweeps and knots is fixed, so the map stays continuous
+on every domain (doc/design.md section 14).
 
 With walls (Bodies.bounds) each robot's change along each axis is kept within
 half its slack to the wall behind it (0 where it is beyond that wall), and
