@@ -38,7 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .certificate import certify, segment_minimum
+from .certificate import certify, evaluates_every_pair, segment_minimum
 from .walls import wall_slack
 
 # Knots per segment: the field is piecewise linear on the j / KNOTS fractions.
@@ -337,6 +337,70 @@ def _interval_minima(planes, knots, pillars=None, offsets=None):
     return result
 
 
+def _pillar_offsets(bodies, k):
+    """Return (k, r) what each robot-pillar gap takes from the distance: both radii."""
+    return bodies.radii[:k, None] + bodies.radii[None, k:]
+
+
+@dataclass(frozen=True, eq=False)
+class _Nearest:
+    """
+    The motion (d, U, k) and, over each knot interval, each robot's smallest exact distance.
+
+    robots (N - 1, k) to another robot, pillars (N - 1, k, r) to each pillar
+    (+inf where a pair cannot hold the robot's smallest slack); None without
+    another robot or without pillars.
+    """
+
+    planes: np.ndarray
+    robots: np.ndarray | None
+    pillars: np.ndarray | None
+
+    @classmethod
+    def of(cls, motion: np.ndarray, knots: _Knots, bodies: Bodies) -> '_Nearest':
+        """Return the smallest distances of the motion at the union's breakpoints (U, k, d)."""
+        k = motion.shape[1]
+        planes = np.ascontiguousarray(np.moveaxis(motion, 2, 0))
+        robots = _interval_minima(planes, knots).min(axis=2) if k > 1 else None
+        pillars = (_interval_minima(planes, knots, bodies.obstacles, _pillar_offsets(bodies, k))
+                   if len(bodies.obstacles) else None)
+        return cls(planes, robots, pillars)
+
+    def gap(self, knots: _Knots, bodies: Bodies) -> float:
+        """
+        Return the motion's exact smallest gap, bit for bit certify's on the same breakpoints.
+
+        certify takes every pair's closed form on every leg (when
+        evaluates_every_pair) and its smallest distance less both radii (0
+        without a positive radius); the knot intervals cover every leg but
+        those before the first knot and after the last, taken here. The
+        minimum over the robots is the minimum over the pairs, and rounding is
+        monotone, so the smallest gap is the same number.
+        """
+        k = self.planes.shape[2]
+        radii = bodies.radii if np.any(bodies.radii > 0) else np.zeros_like(bodies.radii)
+        points, breakpoints = knots.points, self.planes.shape[1]
+        legs = np.concatenate([np.arange(points[0]), np.arange(points[-1], breakpoints - 1)])
+        gaps = [np.inf]
+        if self.robots is not None:
+            a, b = np.triu_indices(k, 1)
+            ends = self.planes[:, np.concatenate([legs, legs + 1])]
+            relative = np.take(ends, a, axis=2) - np.take(ends, b, axis=2)
+            squared, _ = segment_minimum(relative[:, :legs.size],
+                                         relative[:, legs.size:] - relative[:, :legs.size])
+            nearest = min(float(self.robots.min()), float(np.sqrt(squared.min(initial=np.inf))))
+            gaps.append(float(nearest - (radii[0] + radii[0])))
+        if self.pillars is not None:
+            offsets = radii[:k, None] + radii[None, k:]
+            ends = self.planes[:, np.concatenate([legs, legs + 1]), :, None]
+            relative = ends - bodies.obstacles.T[:, None, None, :]
+            squared, _ = segment_minimum(relative[:, :legs.size],
+                                         relative[:, legs.size:] - relative[:, :legs.size])
+            gaps.append(float((self.pillars - offsets).min()))
+            gaps.append(float((np.sqrt(squared) - offsets).min(initial=np.inf)))
+        return min(gaps)
+
+
 class _Caps:
     """
     Each robot's caps at every knot: (N, k) for its robot pairs and for the pillars.
@@ -348,25 +412,23 @@ class _Caps:
     pillar); 0 at the configurations (design, 14).
     """
 
-    def __init__(self, motion, knots, bodies, step):
-        """Compute the caps for the motion at the union's breakpoints (U, k, d)."""
-        intervals, k = knots.points.size - 1, motion.shape[1]
-        planes = np.ascontiguousarray(np.moveaxis(motion, 2, 0))
+    def __init__(self, nearest, knots, bodies, step):
+        """Compute the caps from the motion's smallest distances (_Nearest)."""
+        intervals, k = knots.points.size - 1, nearest.planes.shape[2]
         floor = bodies.margin + bodies.rounding
         pair = np.full((intervals, k), step)
-        if k > 1:
-            slack = _interval_minima(planes, knots).min(axis=2) - 2 * bodies.radii[0] - floor
+        if nearest.robots is not None:
+            slack = nearest.robots - 2 * bodies.radii[0] - floor
             pair = np.minimum(pair, PAIR_SHARE * np.maximum(slack, 0.0))
         pillar = np.full((intervals, k), 2 * step)
-        if len(bodies.obstacles):
-            offsets = bodies.radii[:k, None] + bodies.radii[None, k:] + floor
-            slack = (_interval_minima(planes, knots, bodies.obstacles, offsets)
-                     - offsets).min(axis=2)
+        if nearest.pillars is not None:
+            offsets = _pillar_offsets(bodies, k) + floor
+            slack = (nearest.pillars - offsets).min(axis=2)
             pillar = np.minimum(pillar, PILLAR_SHARE * np.maximum(slack, 0.0))
         self.pair, self.pillar = _knot_caps(pair), _knot_caps(pillar)
         self.lower = self.upper = self.inward = None
         if bodies.bounds is not None:
-            self._walls(_interval_boxes(planes, knots.points), bodies, step)
+            self._walls(_interval_boxes(nearest.planes, knots.points), bodies, step)
 
     def _walls(self, boxes, bodies, step):
         """
@@ -506,8 +568,16 @@ def refine(times: np.ndarray, positions: np.ndarray, waypoint_indices: np.ndarra
     knot_grid = knot_times(segments, KNOTS)
     union = union_motion(times, positions, waypoint_indices, knot_grid)
     knots = _Knots.of(union, knot_grid)
-    gap = certify(union.times, union.positions, bodies.obstacles,
-                  bodies.radii if np.any(bodies.radii > 0) else None).distance
+    blocks = block_count(k)
+    nearest = _Nearest.of(union.positions, knots, bodies) if blocks else None
+    # The first block's distances give the union motion's exact gap where certify would
+    # take every pair on every leg with the radii the caps take (one radius for every robot).
+    if (nearest is not None and evaluates_every_pair(union.positions, bodies.obstacles)
+            and np.all(bodies.radii >= 0) and np.all(bodies.radii[:k] == bodies.radii[0])):
+        gap = nearest.gap(knots, bodies)
+    else:
+        gap = certify(union.times, union.positions, bodies.obstacles,
+                      bodies.radii if np.any(bodies.radii > 0) else None).distance
     bodies = Bodies(bodies.obstacles, bodies.radii, min(bodies.margin, gap), bodies.rounding,
                     bodies.bounds)
     scale = fleet_scale(configurations, bodies.obstacles)
@@ -515,8 +585,10 @@ def refine(times: np.ndarray, positions: np.ndarray, waypoint_indices: np.ndarra
     values = np.zeros((knots.times.size, k, d))
     motion = union.positions
     step = STEP * scale
-    for _ in range(block_count(k)):
-        caps = _Caps(motion, knots, bodies, step)
+    for block_index in range(blocks):
+        if block_index:
+            nearest = _Nearest.of(motion, knots, bodies)
+        caps = _Caps(nearest, knots, bodies, step)
         block = _Block(caps, step)
         common, own = ((np.zeros((values.shape[0], d)), np.zeros_like(values))
                        if caps.inward is None else block.clip(caps.inward))
