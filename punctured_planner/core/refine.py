@@ -35,6 +35,7 @@ construction's, and a motion inside stays inside (doc/design.md section 14).
 """
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -212,12 +213,29 @@ def _planes_length(planes):
     return np.sqrt(squared)
 
 
-def _pair_minimum(values, a, b, k):
-    """Return (..., k) each robot's smallest value over its pairs (a, b) of values (..., pairs)."""
-    matrix = np.full(values.shape[:-1] + (k, k), np.inf)
-    matrix[..., a, b] = values
-    matrix[..., b, a] = values
-    return matrix.min(axis=-1)
+@lru_cache(maxsize=8)
+def _pair_groups(k):
+    """
+    Return (firsts, order, seconds) to reduce values over the pairs np.triu_indices(k, 1).
+
+    The pairs of robot i as the first are a contiguous run starting at firsts[i]
+    (i < k - 1); taken in order, those of robot i as the second start at
+    seconds[i - 1] (i > 0).
+    """
+    a, b = np.triu_indices(k, 1)
+    order = np.argsort(b, kind='stable')
+    return (np.searchsorted(a, np.arange(k - 1)), order,
+            np.searchsorted(b[order], np.arange(1, k)))
+
+
+def _pair_minimum(values, k):
+    """Return (..., k) each robot's smallest value over its pairs of values (..., pairs)."""
+    firsts, order, seconds = _pair_groups(k)
+    result = np.full(values.shape[:-1] + (k,), np.inf)
+    result[..., :-1] = np.minimum.reduceat(values, firsts, axis=-1)
+    np.minimum(result[..., 1:], np.minimum.reduceat(np.take(values, order, axis=-1), seconds,
+                                                    axis=-1), out=result[..., 1:])
+    return result
 
 
 def _runs(points, legs):
@@ -245,8 +263,7 @@ def _near_pairs(planes, points, runs, a, b, margin):
     lasts = np.array([last for _, last in runs])
     knots = planes[:, points[firsts[0]:lasts[-1]]]
     nearest = _pair_minimum(
-        _planes_length(np.take(knots, a, axis=2) - np.take(knots, b, axis=2)), a, b,
-        planes.shape[2])
+        _planes_length(np.take(knots, a, axis=2) - np.take(knots, b, axis=2)), planes.shape[2])
     near = np.maximum.reduceat(nearest, firsts - firsts[0], axis=0) + margin
     begins, ends = points[firsts], points[lasts]
     piece = planes[:, begins[0]:ends[-1] + 1]
@@ -285,20 +302,20 @@ def _near_pillars(planes, points, runs, pillars, offsets, margin):
 
 def _interval_minima(planes, knots, pillars=None, offsets=None):
     """
-    Return (N - 1, k, m) the exact smallest distance over each knot interval, densely.
+    Return each robot's exact smallest distance over each knot interval, densely.
 
-    From every robot to every robot (m = k, the diagonal +inf) or, with pillars
-    (m, d), to every pillar (whose caps take offsets (k, m) from the distance):
-    the closed form on every leg of the union, then the minimum over each
-    interval's legs. planes is the motion coordinate
-    first (d, U, k). Dense arrays over a few hundred legs cost less than
-    choosing pairs would; a run of whole intervals at a time bounds the
-    temporaries (the grouping does not change any value). Pairs too far apart
+    To another robot, (N - 1, k), or with pillars (m, d), to each pillar (whose
+    caps take offsets (k, m) from the distance), (N - 1, k, m): the closed form
+    on every leg of the union, then the minimum over each interval's legs.
+    planes is the motion coordinate first (d, U, k). Dense arrays over a few
+    hundred legs cost less than choosing pairs would; a run of whole intervals
+    at a time bounds the temporaries (the grouping does not change any value).
+    Pairs too far apart
     over a run to hold any robot's smallest (_near_pairs, _near_pillars) are
     left at +inf: every robot's smallest, all the caps use, stays the same.
     """
     d, _, k = planes.shape
-    # Robot pairs a < b only (np.take keeps the pairs last and contiguous), then mirrored.
+    # Robot pairs a < b only (np.take keeps the pairs last and contiguous).
     a, b = np.triu_indices(k, 1)
     width = a.size if pillars is None else k * pillars.shape[0]
     points = knots.points
@@ -331,10 +348,7 @@ def _interval_minima(planes, knots, pillars=None, offsets=None):
         minima[first:last, kept] = np.sqrt(np.minimum.reduceat(squared, starts, axis=0))
     if pillars is not None:
         return minima.reshape(minima.shape[0], k, pillars.shape[0])
-    result = np.full((minima.shape[0], k, k), np.inf)
-    result[:, a, b] = minima
-    result[:, b, a] = minima
-    return result
+    return _pair_minimum(minima, k)
 
 
 def _pillar_offsets(bodies, k):
@@ -361,7 +375,7 @@ class _Nearest:
         """Return the smallest distances of the motion at the union's breakpoints (U, k, d)."""
         k = motion.shape[1]
         planes = np.ascontiguousarray(np.moveaxis(motion, 2, 0))
-        robots = _interval_minima(planes, knots).min(axis=2) if k > 1 else None
+        robots = _interval_minima(planes, knots) if k > 1 else None
         pillars = (_interval_minima(planes, knots, bodies.obstacles, _pillar_offsets(bodies, k))
                    if len(bodies.obstacles) else None)
         return cls(planes, robots, pillars)
