@@ -189,8 +189,8 @@ def _length(vectors):
     """Return the lengths (...) of vectors (..., d); a sum per coordinate is faster."""
     squared = vectors[..., 0] * vectors[..., 0]
     for axis in range(1, vectors.shape[-1]):
-        squared = squared + vectors[..., axis] * vectors[..., axis]
-    return np.sqrt(squared)
+        squared += vectors[..., axis] * vectors[..., axis]
+    return np.sqrt(squared, out=squared)
 
 
 def _interval_boxes(planes, points):
@@ -483,7 +483,7 @@ def _clipped(move, caps):
     """Return the moves (..., d) scaled down to lengths <= caps (...); zero at cap 0."""
     length = _length(move)
     over = length > caps
-    scale = np.where(over, caps / np.where(over, length, 1.0), 1.0)
+    scale = np.divide(caps, length, out=np.ones_like(length), where=over)
     return move * scale[..., None]
 
 
@@ -542,12 +542,17 @@ def _sweep(origin, common, own, block):
     knots plus the field so far, in that order.
     """
     for parity in (1, 0):
-        current = origin + common[:, None] + own
+        current = origin + common[:, None]
+        current += own
         # The knots of this parity (slices: views, not gathers) and their two neighbours.
         first = parity + (1 - parity) * 2
         index = slice(first, current.shape[0] - 1, 2)
         before, after = slice(first - 1, -2, 2), slice(first + 1, None, 2)
-        move = RELAXATION * (0.5 * (current[before] + current[after]) - current[index])
+        # RELAXATION x (the neighbours' midpoint - the knot), in place.
+        move = current[before] + current[after]
+        move *= 0.5
+        move -= current[index]
+        move *= RELAXATION
         wanted = common[:, None] + own
         wanted[index] += move
         common, own = block.clip(wanted)
