@@ -320,6 +320,22 @@ def _nothing(positions, obstacles, resolution):
     return None
 
 
+def evaluates_every_pair(positions: np.ndarray, obstacles: np.ndarray) -> bool:
+    """
+    Return whether certify takes every pair's closed form on every leg, unscaled.
+
+    Then its gap is the smallest, over every pair, of the pair's smallest
+    distance over every leg (segment_minimum on the differences of the
+    breakpoints, as given) less the pair's radii, exactly; robots and pillars
+    (V, k, d) and (r, d).
+    """
+    v, k, d = positions.shape
+    pairs = k * (k - 1) // 2 + k * len(obstacles)
+    scale = max(_scale(positions), _scale(obstacles))
+    return (k <= _DIRECT_ROBOTS and pairs * v * d <= _CHUNK_ELEMENTS
+            and (scale == 0 or _UNSCALED[0] <= scale <= _UNSCALED[1]))
+
+
 def certify(times: np.ndarray, positions: np.ndarray, obstacles: np.ndarray,
             radii: np.ndarray | None = None) -> Clearance:
     """

@@ -21,10 +21,11 @@ smallest robot-pillar slack; each knot's total move in the block is split into
 the fleet's common translation (which robot pairs do not feel) and each
 robot's own part, each clipped to its caps and to a fixed step. Gap distance
 is 1-Lipschitz in each robot's position, so no gap falls below g0 (the caps
-lemma). Every pair is evaluated, so no pair enters or leaves the checked set;
-every quantity is a continuous function of the input, and the number of
-blocks, sweeps and knots is fixed, so the map stays continuous on every domain
-(doc/design.md section 14).
+lemma). Every robot's smallest slack is over every pair (pairs that cannot
+hold it are skipped, exactly: the same values), so no pair enters or leaves
+the checked set; every quantity is a continuous function of the input, and
+the number of blocks, sweeps and knots is fixed, so the map stays continuous
+on every domain (doc/design.md section 14).
 
 With walls (Bodies.bounds) each robot's change along each axis is kept within
 half its slack to the wall behind it (0 where it is beyond that wall), and
@@ -34,10 +35,11 @@ construction's, and a motion inside stays inside (doc/design.md section 14).
 """
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
-from .certificate import certify, segment_minimum
+from .certificate import certify, evaluates_every_pair, segment_minimum
 from .walls import wall_slack
 
 # Knots per segment: the field is piecewise linear on the j / KNOTS fractions.
@@ -69,8 +71,16 @@ PAIR_SHARE, PILLAR_SHARE = 0.25, 0.5
 # weaker, for nothing but rounding).
 _TRANSLATION = 4.0
 # Entries (coordinate x leg x robot x robot or pillar) of the slack arrays computed at
-# once.
-_ENTRIES = 1 << 21
+# once: a few hundred kB stay in cache (with 1 << 21, megabytes per pass, the caps of a
+# 40-robot plan took about 1.5x as long).
+_ENTRIES = 1 << 15
+# The robot-pair filter's allowance for rounding, as a share of the coordinate scale: the
+# closed form and the bounds each round to a few ulps of it, 1e5 times less.
+_BOUND_SLACK = 1e-9
+# Coordinates up to this size are filtered; beyond, squares could overflow.
+_FILTERED_SCALE = 1e150
+# Entries (coordinate x knot x robot pair) of the filter's arrays computed at once.
+_FILTER_ENTRIES = 1 << 17
 
 
 @dataclass(frozen=True, eq=False)
@@ -179,8 +189,8 @@ def _length(vectors):
     """Return the lengths (...) of vectors (..., d); a sum per coordinate is faster."""
     squared = vectors[..., 0] * vectors[..., 0]
     for axis in range(1, vectors.shape[-1]):
-        squared = squared + vectors[..., axis] * vectors[..., axis]
-    return np.sqrt(squared)
+        squared += vectors[..., axis] * vectors[..., axis]
+    return np.sqrt(squared, out=squared)
 
 
 def _interval_boxes(planes, points):
@@ -195,44 +205,214 @@ def _interval_boxes(planes, points):
     return low, high
 
 
-def _interval_minima(planes, knots, pillars=None):
-    """
-    Return (N - 1, k, m) the exact smallest distance over each knot interval, densely.
+def _planes_length(planes):
+    """Return the lengths (...) of coordinate-first vectors (d, ...)."""
+    squared = planes[0] * planes[0]
+    for axis in range(1, planes.shape[0]):
+        squared += planes[axis] * planes[axis]
+    return np.sqrt(squared)
 
-    From every robot to every robot (m = k, the diagonal +inf) or, with pillars
-    (m, d), to every pillar: the closed form on every leg of the union, then
-    the minimum over each interval's legs. planes is the motion coordinate
-    first (d, U, k). Dense arrays over a few hundred legs cost less than
-    choosing pairs would; a run of whole intervals at a time bounds the
-    temporaries (the grouping does not change any value).
+
+@lru_cache(maxsize=8)
+def _pair_groups(k):
+    """
+    Return (firsts, order, seconds) to reduce values over the pairs np.triu_indices(k, 1).
+
+    The pairs of robot i as the first are a contiguous run starting at firsts[i]
+    (i < k - 1); taken in order, those of robot i as the second start at
+    seconds[i - 1] (i > 0).
+    """
+    a, b = np.triu_indices(k, 1)
+    order = np.argsort(b, kind='stable')
+    return (np.searchsorted(a, np.arange(k - 1)), order,
+            np.searchsorted(b[order], np.arange(1, k)))
+
+
+def _pair_minimum(values, k):
+    """Return (..., k) each robot's smallest value over its pairs of values (..., pairs)."""
+    firsts, order, seconds = _pair_groups(k)
+    result = np.full(values.shape[:-1] + (k,), np.inf)
+    result[..., :-1] = np.minimum.reduceat(values, firsts, axis=-1)
+    np.minimum(result[..., 1:], np.minimum.reduceat(np.take(values, order, axis=-1), seconds,
+                                                    axis=-1), out=result[..., 1:])
+    return result
+
+
+def _runs(points, legs):
+    """Return [(first, last), ...]: runs of whole knot intervals of about legs legs each."""
+    runs, first, intervals = [], 0, points.size - 1
+    while first < intervals:
+        last = int(np.searchsorted(points, points[first] + legs, side='right')) - 1
+        last = min(max(last, first + 1), intervals)
+        runs.append((first, last))
+        first = last
+    return runs
+
+
+def _near_pairs(planes, points, runs, a, b, margin):
+    """
+    Return (runs, pairs) whether each pair can hold a robot's smallest distance in each run.
+
+    In every interval each robot comes within its nearest partner's distance at
+    the interval's first knot (plus margin, far above rounding); a pair whose
+    boxes over the run stay farther apart than the largest of those for both
+    of its robots is never the smallest of either, so the pairs kept give
+    every robot's very minimum.
+    """
+    firsts = np.array([first for first, _ in runs])
+    lasts = np.array([last for _, last in runs])
+    knots = planes[:, points[firsts[0]:lasts[-1]]]
+    nearest = _pair_minimum(
+        _planes_length(np.take(knots, a, axis=2) - np.take(knots, b, axis=2)), planes.shape[2])
+    near = np.maximum.reduceat(nearest, firsts - firsts[0], axis=0) + margin
+    begins, ends = points[firsts], points[lasts]
+    piece = planes[:, begins[0]:ends[-1] + 1]
+    # The motion is linear between breakpoints: their box over a run holds all of it.
+    low = np.minimum(np.minimum.reduceat(piece, begins - begins[0], axis=1), planes[:, ends])
+    high = np.maximum(np.maximum.reduceat(piece, begins - begins[0], axis=1), planes[:, ends])
+    gap = np.maximum(np.take(low, a, axis=2) - np.take(high, b, axis=2),
+                     np.take(low, b, axis=2) - np.take(high, a, axis=2))
+    np.maximum(gap, 0.0, out=gap)
+    return _planes_length(gap) - margin <= np.maximum(np.take(near, a, axis=1),
+                                                      np.take(near, b, axis=1))
+
+
+def _near_pillars(planes, points, runs, pillars, offsets, margin):
+    """
+    Return (runs, k r) whether each robot-pillar pair can hold a robot's smallest slack.
+
+    _near_pairs for pillars (r, d): the slack is the distance less offsets (k, r);
+    each robot keeps its smallest at an interval's first knot (plus margin).
+    """
+    firsts = np.array([first for first, _ in runs])
+    lasts = np.array([last for _, last in runs])
+    centres = pillars.T[:, None, None, :]
+    knots = planes[:, points[firsts[0]:lasts[-1]], :, None]
+    nearest = (_planes_length(knots - centres) - offsets).min(axis=2)
+    near = np.maximum.reduceat(nearest, firsts - firsts[0], axis=0) + margin
+    begins, ends = points[firsts], points[lasts]
+    piece = planes[:, begins[0]:ends[-1] + 1]
+    low = np.minimum(np.minimum.reduceat(piece, begins - begins[0], axis=1), planes[:, ends])
+    high = np.maximum(np.maximum.reduceat(piece, begins - begins[0], axis=1), planes[:, ends])
+    gap = np.maximum(low[..., None] - centres, centres - high[..., None])
+    np.maximum(gap, 0.0, out=gap)
+    keep = _planes_length(gap) - offsets - margin <= near[:, :, None]
+    return keep.reshape(len(runs), -1)
+
+
+def _interval_minima(planes, knots, pillars=None, offsets=None):
+    """
+    Return each robot's exact smallest distance over each knot interval, densely.
+
+    To another robot, (N - 1, k), or with pillars (m, d), to each pillar (whose
+    caps take offsets (k, m) from the distance), (N - 1, k, m): the closed form
+    on every leg of the union, then the minimum over each interval's legs.
+    planes is the motion coordinate first (d, U, k). Dense arrays over a few
+    hundred legs cost less than choosing pairs would; a run of whole intervals
+    at a time bounds the temporaries (the grouping does not change any value).
+    Pairs too far apart
+    over a run to hold any robot's smallest (_near_pairs, _near_pillars) are
+    left at +inf: every robot's smallest, all the caps use, stays the same.
     """
     d, _, k = planes.shape
-    # Robot pairs a < b only (np.take keeps the pairs last and contiguous), then mirrored.
+    # Robot pairs a < b only (np.take keeps the pairs last and contiguous).
     a, b = np.triu_indices(k, 1)
     width = a.size if pillars is None else k * pillars.shape[0]
     points = knots.points
-    minima = np.empty((points.size - 1, width))
-    legs = max(1, _ENTRIES // (d * max(width, 1)))
-    first = 0
-    while first < minima.shape[0]:
-        last = int(np.searchsorted(points, points[first] + legs, side='right')) - 1
-        last = min(max(last, first + 1), minima.shape[0])
+    minima = np.full((points.size - 1, width), np.inf)
+    runs = _runs(points, max(1, _ENTRIES // (d * max(width, 1))))
+    scale = max(float(np.abs(planes).max(initial=0.0)),
+                0.0 if pillars is None else float(np.abs(pillars).max(initial=0.0)))
+    near = np.ones((len(runs), width), dtype=bool)
+    # Squares this large could overflow (inf, nan), which the filter must not drop.
+    if scale < _FILTERED_SCALE:
+        # The filter's arrays for a batch of runs: about _FILTER_ENTRIES entries.
+        batch = max(1, _FILTER_ENTRIES * len(runs) // (d * (points.size - 1) * max(width, 1)))
+        for run in range(0, len(runs), batch):
+            chosen = runs[run:run + batch]
+            margin = _BOUND_SLACK * scale
+            near[run:run + batch] = (
+                _near_pairs(planes, points, chosen, a, b, margin) if pillars is None else
+                _near_pillars(planes, points, chosen, pillars, offsets,
+                              margin + _BOUND_SLACK * float(np.abs(offsets).max())))
+    for run, (first, last) in enumerate(runs):
         piece = planes[:, points[first]:points[last] + 1]
-        if pillars is None:
-            relative = np.take(piece, a, axis=2) - np.take(piece, b, axis=2)
+        starts = points[first:last] - points[first]
+        kept = np.flatnonzero(near[run])
+        if pillars is not None:
+            robot, pillar = np.divmod(kept, pillars.shape[0])
+            relative = np.take(piece, robot, axis=2) - pillars.T[:, None, pillar]
         else:
-            relative = (piece[:, :, :, None] - pillars.T[:, None, None, :]).reshape(
-                d, piece.shape[1], width)
+            relative = np.take(piece, a[kept], axis=2) - np.take(piece, b[kept], axis=2)
         squared, _ = segment_minimum(relative[:, :-1], relative[:, 1:] - relative[:, :-1])
-        minima[first:last] = np.sqrt(np.minimum.reduceat(
-            squared, points[first:last] - points[first], axis=0))
-        first = last
+        minima[first:last, kept] = np.sqrt(np.minimum.reduceat(squared, starts, axis=0))
     if pillars is not None:
         return minima.reshape(minima.shape[0], k, pillars.shape[0])
-    result = np.full((minima.shape[0], k, k), np.inf)
-    result[:, a, b] = minima
-    result[:, b, a] = minima
-    return result
+    return _pair_minimum(minima, k)
+
+
+def _pillar_offsets(bodies, k):
+    """Return (k, r) what each robot-pillar gap takes from the distance: both radii."""
+    return bodies.radii[:k, None] + bodies.radii[None, k:]
+
+
+@dataclass(frozen=True, eq=False)
+class _Nearest:
+    """
+    The motion (d, U, k) and, over each knot interval, each robot's smallest exact distance.
+
+    robots (N - 1, k) to another robot, pillars (N - 1, k, r) to each pillar
+    (+inf where a pair cannot hold the robot's smallest slack); None without
+    another robot or without pillars.
+    """
+
+    planes: np.ndarray
+    robots: np.ndarray | None
+    pillars: np.ndarray | None
+
+    @classmethod
+    def of(cls, motion: np.ndarray, knots: _Knots, bodies: Bodies) -> '_Nearest':
+        """Return the smallest distances of the motion at the union's breakpoints (U, k, d)."""
+        k = motion.shape[1]
+        planes = np.ascontiguousarray(np.moveaxis(motion, 2, 0))
+        robots = _interval_minima(planes, knots) if k > 1 else None
+        pillars = (_interval_minima(planes, knots, bodies.obstacles, _pillar_offsets(bodies, k))
+                   if len(bodies.obstacles) else None)
+        return cls(planes, robots, pillars)
+
+    def gap(self, knots: _Knots, bodies: Bodies) -> float:
+        """
+        Return the motion's exact smallest gap, bit for bit certify's on the same breakpoints.
+
+        certify takes every pair's closed form on every leg (when
+        evaluates_every_pair) and its smallest distance less both radii (0
+        without a positive radius); the knot intervals cover every leg but
+        those before the first knot and after the last, taken here. The
+        minimum over the robots is the minimum over the pairs, and rounding is
+        monotone, so the smallest gap is the same number.
+        """
+        k = self.planes.shape[2]
+        radii = bodies.radii if np.any(bodies.radii > 0) else np.zeros_like(bodies.radii)
+        points, breakpoints = knots.points, self.planes.shape[1]
+        legs = np.concatenate([np.arange(points[0]), np.arange(points[-1], breakpoints - 1)])
+        gaps = [np.inf]
+        if self.robots is not None:
+            a, b = np.triu_indices(k, 1)
+            ends = self.planes[:, np.concatenate([legs, legs + 1])]
+            relative = np.take(ends, a, axis=2) - np.take(ends, b, axis=2)
+            squared, _ = segment_minimum(relative[:, :legs.size],
+                                         relative[:, legs.size:] - relative[:, :legs.size])
+            nearest = min(float(self.robots.min()), float(np.sqrt(squared.min(initial=np.inf))))
+            gaps.append(float(nearest - (radii[0] + radii[0])))
+        if self.pillars is not None:
+            offsets = radii[:k, None] + radii[None, k:]
+            ends = self.planes[:, np.concatenate([legs, legs + 1]), :, None]
+            relative = ends - bodies.obstacles.T[:, None, None, :]
+            squared, _ = segment_minimum(relative[:, :legs.size],
+                                         relative[:, legs.size:] - relative[:, :legs.size])
+            gaps.append(float((self.pillars - offsets).min()))
+            gaps.append(float((np.sqrt(squared) - offsets).min(initial=np.inf)))
+        return min(gaps)
 
 
 class _Caps:
@@ -246,24 +426,23 @@ class _Caps:
     pillar); 0 at the configurations (design, 14).
     """
 
-    def __init__(self, motion, knots, bodies, step):
-        """Compute the caps for the motion at the union's breakpoints (U, k, d)."""
-        intervals, k = knots.points.size - 1, motion.shape[1]
-        planes = np.ascontiguousarray(np.moveaxis(motion, 2, 0))
+    def __init__(self, nearest, knots, bodies, step):
+        """Compute the caps from the motion's smallest distances (_Nearest)."""
+        intervals, k = knots.points.size - 1, nearest.planes.shape[2]
         floor = bodies.margin + bodies.rounding
         pair = np.full((intervals, k), step)
-        if k > 1:
-            slack = _interval_minima(planes, knots).min(axis=2) - 2 * bodies.radii[0] - floor
+        if nearest.robots is not None:
+            slack = nearest.robots - 2 * bodies.radii[0] - floor
             pair = np.minimum(pair, PAIR_SHARE * np.maximum(slack, 0.0))
         pillar = np.full((intervals, k), 2 * step)
-        if len(bodies.obstacles):
-            offsets = bodies.radii[:k, None] + bodies.radii[None, k:] + floor
-            slack = (_interval_minima(planes, knots, bodies.obstacles) - offsets).min(axis=2)
+        if nearest.pillars is not None:
+            offsets = _pillar_offsets(bodies, k) + floor
+            slack = (nearest.pillars - offsets).min(axis=2)
             pillar = np.minimum(pillar, PILLAR_SHARE * np.maximum(slack, 0.0))
         self.pair, self.pillar = _knot_caps(pair), _knot_caps(pillar)
         self.lower = self.upper = self.inward = None
         if bodies.bounds is not None:
-            self._walls(_interval_boxes(planes, knots.points), bodies, step)
+            self._walls(_interval_boxes(nearest.planes, knots.points), bodies, step)
 
     def _walls(self, boxes, bodies, step):
         """
@@ -304,7 +483,7 @@ def _clipped(move, caps):
     """Return the moves (..., d) scaled down to lengths <= caps (...); zero at cap 0."""
     length = _length(move)
     over = length > caps
-    scale = np.where(over, caps / np.where(over, length, 1.0), 1.0)
+    scale = np.divide(caps, length, out=np.ones_like(length), where=over)
     return move * scale[..., None]
 
 
@@ -352,19 +531,28 @@ class _Block:
         return common, own
 
 
-def _sweep(start, common, own, base_knots, block):
+def _sweep(origin, common, own, block):
     """
     Return (common, own) after one red-black sweep of over-relaxed smoothing.
 
     Each knot moves RELAXATION x the way to its neighbours' midpoint, the move
     split into the fleet's mean and each robot's own part; knots of one parity
     have no neighbour of the same parity, so each half sweep uses the other
-    half's newest values.
+    half's newest values. origin is where the block starts: the construction's
+    knots plus the field so far, in that order.
     """
     for parity in (1, 0):
-        current = base_knots + start + common[:, None] + own
-        index = np.arange(parity + (1 - parity) * 2, current.shape[0] - 1, 2)
-        move = RELAXATION * (0.5 * (current[index - 1] + current[index + 1]) - current[index])
+        current = origin + common[:, None]
+        current += own
+        # The knots of this parity (slices: views, not gathers) and their two neighbours.
+        first = parity + (1 - parity) * 2
+        index = slice(first, current.shape[0] - 1, 2)
+        before, after = slice(first - 1, -2, 2), slice(first + 1, None, 2)
+        # RELAXATION x (the neighbours' midpoint - the knot), in place.
+        move = current[before] + current[after]
+        move *= 0.5
+        move -= current[index]
+        move *= RELAXATION
         wanted = common[:, None] + own
         wanted[index] += move
         common, own = block.clip(wanted)
@@ -399,8 +587,16 @@ def refine(times: np.ndarray, positions: np.ndarray, waypoint_indices: np.ndarra
     knot_grid = knot_times(segments, KNOTS)
     union = union_motion(times, positions, waypoint_indices, knot_grid)
     knots = _Knots.of(union, knot_grid)
-    gap = certify(union.times, union.positions, bodies.obstacles,
-                  bodies.radii if np.any(bodies.radii > 0) else None).distance
+    blocks = block_count(k)
+    nearest = _Nearest.of(union.positions, knots, bodies) if blocks else None
+    # The first block's distances give the union motion's exact gap where certify would
+    # take every pair on every leg with the radii the caps take (one radius for every robot).
+    if (nearest is not None and evaluates_every_pair(union.positions, bodies.obstacles)
+            and np.all(bodies.radii >= 0) and np.all(bodies.radii[:k] == bodies.radii[0])):
+        gap = nearest.gap(knots, bodies)
+    else:
+        gap = certify(union.times, union.positions, bodies.obstacles,
+                      bodies.radii if np.any(bodies.radii > 0) else None).distance
     bodies = Bodies(bodies.obstacles, bodies.radii, min(bodies.margin, gap), bodies.rounding,
                     bodies.bounds)
     scale = fleet_scale(configurations, bodies.obstacles)
@@ -408,13 +604,16 @@ def refine(times: np.ndarray, positions: np.ndarray, waypoint_indices: np.ndarra
     values = np.zeros((knots.times.size, k, d))
     motion = union.positions
     step = STEP * scale
-    for _ in range(block_count(k)):
-        caps = _Caps(motion, knots, bodies, step)
+    for block_index in range(blocks):
+        if block_index:
+            nearest = _Nearest.of(motion, knots, bodies)
+        caps = _Caps(nearest, knots, bodies, step)
         block = _Block(caps, step)
         common, own = ((np.zeros((values.shape[0], d)), np.zeros_like(values))
                        if caps.inward is None else block.clip(caps.inward))
+        origin = base_knots + values
         for _ in range(SWEEPS):
-            common, own = _sweep(values, common, own, base_knots, block)
+            common, own = _sweep(origin, common, own, block)
         values = values + common[:, None] + own
         # x + 0.0 is x: a robot held everywhere in an interval keeps x's breakpoints.
         motion = union.positions + knots.field(values)
