@@ -48,6 +48,10 @@ HISTORY = 100
 SETTLE = 0.5
 # Largest feed-forward gain: a robot that achieves a quarter of its commands is not helped.
 MAX_FEEDFORWARD_GAIN = 4.0
+# Share of each robot's acceleration limit its reference may use (the clock's reference is
+# timed for it): the rest is the feedback's, to shed what a late robot gained in its
+# latency where the reference brakes (doc/design.md section 13, "Room to correct").
+ACCELERATION_SHARE = 0.6
 # Reference speed (m/s) below which a robot's lag says nothing about its feed-forward
 # (and the clock's rise counts the reference as moving this fast).
 ADAPT_SPEED = 0.05
@@ -152,24 +156,26 @@ class Execution:
         """
         Start at plan time 0 with no error measured yet; ValueError if drive does not fit.
 
-        With robots slower than the plan (settings.max_speeds, max_accelerations)
-        the clock runs on the plan retimed for them (Reference.retimed): its
-        plan time is then that timing's.
+        The clock runs on the plan retimed (Reference.retimed) for robots slower
+        than the plan (settings.max_speeds), and, for a plan timed under an
+        acceleration limit, for ACCELERATION_SHARE of each robot's acceleration
+        (max_accelerations, else the plan's): its plan time is then that timing's.
         """
         self.tolerance = float(tolerance)
         k = reference.robot_count
         speeds, accelerations = settings.limits(k)
         profile = reference.profile
         plan_acceleration = np.full(k, profile.max_acceleration if profile else np.inf)
-        # (k,) each robot's acceleration limit as the clock's rise sees it
-        self.accelerations = (plan_acceleration if accelerations is None
-                              else np.minimum(accelerations, plan_acceleration))
+        # (k,) the acceleration each robot's reference (and the clock's rise) may use
+        self.accelerations = ACCELERATION_SHARE * (
+            plan_acceleration if accelerations is None
+            else np.minimum(accelerations, plan_acceleration))
         self.differential = settings.differential(k)
         # a timed plan stops where a differential robot must turn in place (its clock then
         # holds with every robot at rest, doc/design.md section 13)
         stops = (unicycle.Corners(reference.seconds, reference.positions).turns(
             self.differential) if profile is not None else np.zeros(0, dtype=bool))
-        if speeds is not None or accelerations is not None or stops.any():
+        if speeds is not None or profile is not None:
             reference = reference.retimed(
                 np.full(k, np.inf) if speeds is None else speeds,
                 self.accelerations, 2.0 * self.tolerance, stops if stops.any() else None)

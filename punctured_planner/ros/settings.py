@@ -287,8 +287,9 @@ class ExecutorSettings:
     max_accelerations: tuple = Spec(
         'max_accelerations', 'double_array', [],
         "Each robot's own acceleration limit (m/s^2), one value for all or one per robot; "
-        "empty: the plan's max_acceleration. Retimes a plan stamped under an acceleration "
-        'limit like max_speeds.', check=within(1e-6, 1e3),
+        "empty: the plan's max_acceleration. A plan stamped under an acceleration limit is "
+        "retimed for 0.6 of it (the rest is the feedback's), like max_speeds.",
+        check=within(1e-6, 1e3),
         prose='empty, one, or one per robot, in [1e-06, 1000]').field()
 
     @property
