@@ -235,11 +235,11 @@ class Execution:
         motion = self.reference.velocity(self.plan_time)
         watched, alpha = behind(measured_reference - positions, motion), np.zeros(k)
         if unicycles:
-            # the clock watches each differential robot's bound E of its centre error
+            # a turn may start only while the whole bound E of a robot's centre error is
+            # small; the clock then watches only E's part that waiting reduces (behind)
             lead_points = unicycle.lead_points(positions, self._driving(angles), self.lead)
             bound = np.linalg.norm(measured_reference - lead_points, axis=1) + self.lead
-            watched = np.where(differential, bound, errors)
-            alpha = self._update_turns(angles, watched)
+            alpha = self._update_turns(angles, np.where(differential, bound, errors))
             watched = np.where(differential,
                                behind(measured_reference - lead_points, motion) + self.lead,
                                watched)
