@@ -3,8 +3,9 @@ Differential-drive robots without DDS: the tracking law's bound, the turns, the 
 
 The bound (doc/design.md section 13): the lead point's velocity keeps the
 direction of the law's u under saturation, so with the clock held its error
-never grows; the centre is within the lead e of it; a turn in place raises
-E = |reference - P| + e by at most 2e; parking never moves away from the goal.
+never grows; the centre is within the lead e of it; a turn in place or a switch of
+driving direction raises E = |reference - P| + e by at most 2e; parking never moves
+away from the goal.
 The closed loops run the real Execution against the real Fleet.
 """
 
@@ -227,10 +228,10 @@ def test_a_reversal_is_driven_backward_not_turned_round():
     assert step.forward[0] < 0 and abs(step.yaw_rates[0]) < 1e-9
 
 
-def test_a_timed_plan_stops_where_a_differential_robot_turns_in_place():
-    """Under an acceleration limit a right angle is a stop at rest, with no corner ramp."""
+def test_a_timed_plan_stops_where_a_differential_robot_switches_direction():
+    """Under an acceleration limit a turn beyond 90 degrees is a stop at rest, no ramp."""
     positions = np.array([[[0, 0, 0], [0, 2, 0]], [[2, 0, 0], [2, 2, 0]],
-                          [[2, 2, 0], [4, 2, 0]]], dtype=float)
+                          [[0, 2, 0], [4, 2, 0]]], dtype=float)
     orientations = np.tile([0.0, 0.0, 0.0, 1.0], (3, 2, 1))
     timed = Reference.timed(np.array([0.0, 3.0, 6.0]), positions, orientations, 1.0, 1.0, 0.5)
     assert timed.profile.speeds[1] > 0, 'the plan passes its corner moving'
@@ -240,11 +241,20 @@ def test_a_timed_plan_stops_where_a_differential_robot_turns_in_place():
     differential = Execution(timed, 0.25, ExecutionSettings(
         drive=drive, speed_limit=1.0, yaw_rate_limit=1.9))
     rests = differential.reference.at_rest()
-    assert rests.tolist() == [True, True, True], 'robot 0 turns by 90 degrees at pose 1'
+    assert rests.tolist() == [True, True, True], 'robot 0 turns by 135 degrees at pose 1'
     assert np.array_equal(differential.reference.positions, positions)
     corner = differential.reference.seconds[1]
     caps = differential.corners.corner_caps(corner - 0.3, differential.steering, 1.9)
     assert caps.tolist() == [1.0, 1.0], 'a stop at rest needs no ramp before it'
+    # a right angle is followed moving, slowed into by the corner ramp
+    right = positions.copy()
+    right[2, 0] = [2, 2, 0]
+    square = Reference.timed(np.array([0.0, 3.0, 6.0]), right, orientations, 1.0, 1.0, 0.5)
+    bent = Execution(square, 0.25, ExecutionSettings(drive=drive, speed_limit=1.0,
+                                                     yaw_rate_limit=1.9))
+    assert bent.reference.at_rest().tolist() == [True, False, True]
+    corner = bent.reference.seconds[1]
+    assert bent.corners.corner_caps(corner - 0.3, bent.steering, 1.9)[0] < 1.0
     # the differential robot straight, the holonomic one turning: no stop
     straight = positions.copy()
     straight[2] = [[4, 0, 0], [2, 4, 0]]

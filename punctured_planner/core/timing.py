@@ -97,11 +97,11 @@ class SpeedProfile:
     max_speed: float | np.ndarray
     max_acceleration: float | np.ndarray
 
-    def _limits(self, leg: int) -> tuple[float, float]:
-        """Return leg's (max_speed, max_acceleration)."""
-        count = len(self.lengths)
-        return (float(np.broadcast_to(self.max_speed, count)[leg]),
-                float(np.broadcast_to(self.max_acceleration, count)[leg]))
+    @cached_property
+    def _accelerations(self) -> np.ndarray:
+        """Return the (L,) legs' acceleration limits (one value broadcast to every leg)."""
+        return np.broadcast_to(np.asarray(self.max_acceleration, dtype=float),
+                               self.lengths.shape)
 
     @cached_property
     def _phases(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -126,7 +126,7 @@ class SpeedProfile:
 
     def time_at(self, leg: int, distances: np.ndarray) -> np.ndarray:
         """Return the seconds from leg's start at which sigma has moved distances along it."""
-        a, start = self._limits(leg)[1], self.speeds[leg]
+        a, start = self._accelerations[leg], self.speeds[leg]
         peak, speeding, cruising, _ = (phase[leg] for phase in self._phases)
         reach = (peak ** 2 - start ** 2) / (2.0 * a)
         x = np.clip(distances, 0.0, self.lengths[leg])
@@ -141,7 +141,7 @@ class SpeedProfile:
 
     def state_at(self, leg: int, seconds: float) -> LegState:
         """Return sigma's LegState seconds after leg's start (clamped to the leg)."""
-        a, start = self._limits(leg)[1], float(self.speeds[leg])
+        a, start = float(self._accelerations[leg]), float(self.speeds[leg])
         peak, speeding, cruising, braking = (float(phase[leg]) for phase in self._phases)
         t = min(max(seconds, 0.0), speeding + cruising + braking)
         if t < speeding:
@@ -168,10 +168,10 @@ def speed_profile(positions: np.ndarray, max_speed: float, max_acceleration: flo
     if not (max_speed > 0 and max_acceleration > 0):
         raise ValueError('max_speed and max_acceleration must be positive')
     lengths = leg_lengths(positions)
-    return _fastest(positions, lengths, np.full(len(lengths), float(max_speed)),
-                    np.full(len(lengths), float(max_acceleration)),
-                    np.full(positions.shape[1], float(jump)), float(max_speed),
-                    float(max_acceleration))
+    speeds = _breakpoint_speeds(positions, lengths, np.full(len(lengths), float(max_speed)),
+                                np.full(len(lengths), float(max_acceleration)),
+                                np.full(positions.shape[1], float(jump)))
+    return SpeedProfile(lengths, speeds, float(max_speed), float(max_acceleration))
 
 
 def fleet_profile(positions: np.ndarray, max_speeds: np.ndarray,
@@ -206,17 +206,16 @@ def fleet_profile(positions: np.ndarray, max_speeds: np.ndarray,
     leg_speeds = np.where(np.isfinite(leg_speeds), leg_speeds, fallback[0])
     leg_accelerations = np.where(np.isfinite(leg_accelerations), leg_accelerations,
                                  fallback[1])
-    return _fastest(positions, lengths, leg_speeds, leg_accelerations, jumps, leg_speeds,
-                    leg_accelerations, stops)
+    speeds = _breakpoint_speeds(positions, lengths, leg_speeds, leg_accelerations, jumps,
+                                stops)
+    return SpeedProfile(lengths, speeds, leg_speeds, leg_accelerations)
 
 
-def _fastest(positions: np.ndarray, lengths: np.ndarray, leg_speeds: np.ndarray,
-             leg_accelerations: np.ndarray, jumps: np.ndarray,
-             max_speed: float | np.ndarray,
-             max_acceleration: float | np.ndarray,
-             stops: np.ndarray | None = None) -> SpeedProfile:
+def _breakpoint_speeds(positions: np.ndarray, lengths: np.ndarray, leg_speeds: np.ndarray,
+                       leg_accelerations: np.ndarray, jumps: np.ndarray,
+                       stops: np.ndarray | None = None) -> np.ndarray:
     """
-    Return the fastest SpeedProfile within per-leg limits (L,) and per-robot jumps (k,).
+    Return the (V,) fastest breakpoint speeds within per-leg limits (L,) and jumps (k,).
 
     A breakpoint's speed is at most both adjacent legs' speed limits and, at a
     corner, min_i jumps[i] / Delta_i (0 at stops (V,)); then a forward and a
@@ -244,7 +243,7 @@ def _fastest(positions: np.ndarray, lengths: np.ndarray, leg_speeds: np.ndarray,
     for leg in range(len(lengths) - 1, -1, -1):
         speeds[leg] = min(speeds[leg], np.sqrt(
             speeds[leg + 1] ** 2 + 2 * leg_accelerations[leg] * lengths[leg]))
-    return SpeedProfile(lengths, speeds, max_speed, max_acceleration)
+    return speeds
 
 
 def stamps(positions: np.ndarray, max_speed: float, max_acceleration: float,

@@ -18,8 +18,9 @@ Each step (doc/design.md section 13; msg_docs/ExecutePlan.md):
 Differential robots (``drive``) track through :mod:`.unicycle` instead: the
 clock sees the bound E = |reference - P| + e of each one's centre error, is
 capped so each can follow its reference's direction and slows before the
-corners ahead; a robot facing too far from where its reference goes turns in
-place while its reference stands still. After the end each parks its centre on
+corners ahead; a robot facing more than 90 degrees from where its reference
+goes drives the other way round, and one whose reference stands still turns
+in place towards its next move. After the end each parks its centre on
 its last position, then turns in place to its last orientation (``final_heading``).
 
 The execution is finished once s reached the plan's end and every robot has
@@ -171,8 +172,8 @@ class Execution:
             plan_acceleration if accelerations is None
             else np.minimum(accelerations, plan_acceleration))
         self.differential = settings.differential(k)
-        # a timed plan stops where a differential robot must turn in place (its clock then
-        # holds with every robot at rest, doc/design.md section 13)
+        # a timed plan stops where a differential robot switches its driving direction
+        # (it passes through rest there anyway, doc/design.md section 13)
         stops = (unicycle.Corners(reference.seconds, reference.positions).turns(
             self.differential) if profile is not None else np.zeros(0, dtype=bool))
         if speeds is not None or profile is not None:
@@ -239,7 +240,7 @@ class Execution:
             # small; the clock then watches only E's part that waiting reduces (behind)
             lead_points = unicycle.lead_points(positions, self._driving(angles), self.lead)
             bound = np.linalg.norm(measured_reference - lead_points, axis=1) + self.lead
-            alpha = self._update_turns(angles, np.where(differential, bound, errors))
+            alpha = self._update_turns(angles, np.where(differential, bound, errors), dt)
             watched = np.where(differential,
                                behind(measured_reference - lead_points, motion) + self.lead,
                                watched)
@@ -252,7 +253,7 @@ class Execution:
         else:
             rate = self._rate_rise(
                 min(clock_rate(watched, self.tolerance, s.slow_fraction, s.hold_fraction),
-                    self._differential_cap(alpha, dt)), dt)
+                    self._differential_cap(alpha)), dt)
         self.rate = rate
         duration = self.reference.duration
         self.plan_time = min(duration, self.plan_time + rate * dt)
@@ -379,28 +380,30 @@ class Execution:
         self.settled = self.settled + dt if arrived and facing else 0.0
         return self.settled >= SETTLE
 
-    def _update_turns(self, angles: np.ndarray, watched: np.ndarray) -> np.ndarray:
+    def _update_turns(self, angles: np.ndarray, watched: np.ndarray,
+                      dt: float) -> np.ndarray:
         """
-        Start and end the differential robots' turns in place; return their misalignments.
+        Switch the differential robots' driving directions and turns; return misalignments.
 
-        A turn starts where the driving heading is more than TURN_ANGLE from
-        the direction the reference moves in (or moves next) and E <= hold
-        delta - 2e, so that E stays below hold delta (it grows by at most 2e
-        while the centre stands); it ends within ALIGNED of that direction.
-        Where driving the other way round needs less turning, the robot
-        switches direction first: its lead point jumps by at most 2e, the same
-        bound.
+        Where the driving heading is more than REVERSE_ANGLE (90 degrees) from
+        the direction the reference moves in (or moves next), driving the other
+        way round needs less turning: the robot switches direction once
+        E <= hold delta - 2e (its lead point jumps by 2e, so E stays below hold
+        delta). So no robot is ever more than 90 degrees from where it goes,
+        and it follows at the creep rate instead of turning in place with the
+        fleet waiting. A robot whose reference stands still for the whole step
+        turns in place towards its next move (the centre stands, E grows by at
+        most 2e) until within ALIGNED of it: that costs the clock nothing.
         """
         s = self.settings
-        directions, _ = self.corners.upcoming(self.plan_time)
+        directions, still_until = self.corners.upcoming(self.plan_time)
         alpha = unicycle.misalignment(self._driving(angles), directions)
         may_turn = watched <= s.hold_fraction * self.tolerance - 2.0 * self.lead
-        flip = (self.differential & may_turn & (np.abs(alpha) > unicycle.TURN_ANGLE)
-                & (np.abs(unicycle.wrap(alpha + np.pi)) < np.abs(alpha)))
+        flip = self.differential & may_turn & (np.abs(alpha) > unicycle.REVERSE_ANGLE)
         self.reverse ^= flip
         alpha = np.where(flip, unicycle.wrap(alpha + np.pi), alpha)
-        start = (np.abs(alpha) > unicycle.TURN_ANGLE) & may_turn
-        self.turning = (self.differential & (self.turning | start)
+        waiting = still_until - self.plan_time >= dt
+        self.turning = (self.differential & waiting & (self.turning | may_turn)
                         & (np.abs(alpha) > unicycle.ALIGNED)
                         & (self.plan_time < self.reference.duration))
         return alpha
@@ -409,24 +412,21 @@ class Execution:
         """Return the driving headings: the yaw, or yaw + pi for robots driving backward."""
         return angles + np.pi * self.reverse
 
-    def _differential_cap(self, alpha: np.ndarray, dt: float) -> float:
+    def _differential_cap(self, alpha: np.ndarray) -> float:
         """
         Return the largest clock rate the differential robots allow this step.
 
-        A turning robot holds the clock unless its reference stands still for
-        the whole step; a following one caps it so its lead point can follow
-        the reference's direction (creep_rate); every one slows into its corners.
+        Each caps it so its lead point can follow its reference's direction
+        (creep_rate: 0 beyond REVERSE_ANGLE, until it has switched direction;
+        1 while its reference stands still, where it may turn in place), and
+        slows into its corners.
         """
         if not self.differential.any():
             return 1.0
-        s_now, settings = self.plan_time, self.settings
-        _, still_until = self.corners.upcoming(s_now)
+        s_now, limit = self.plan_time, self.settings.yaw_rate_limit
         speeds = np.linalg.norm(self.reference.velocity(s_now), axis=1)
-        limit = settings.yaw_rate_limit
-        room = np.clip((still_until - s_now) / dt, 0.0, 1.0) if dt > 0 else np.ones(len(alpha))
-        caps = np.where(self.turning, room,
-                        unicycle.creep_rate(alpha, speeds, self.steering, limit))
-        caps = np.minimum(caps, self.corners.corner_caps(s_now, self.steering, limit))
+        caps = np.minimum(unicycle.creep_rate(alpha, speeds, self.steering, limit),
+                          self.corners.corner_caps(s_now, self.steering, limit))
         return float(np.min(caps[self.differential], initial=1.0))
 
     def _unicycle(self, feedforward: np.ndarray, target: np.ndarray, positions: np.ndarray,

@@ -16,11 +16,14 @@ bound of the centre's error that never grows while the clock holds. l = e
 would be exact feedback linearisation, but the heading would then answer
 within e / v seconds, far faster than a base's command latency: it weaves.
 
-Where following would need a yaw rate beyond the limit (a corner, the start
-facing away), the robot turns in place (v = 0: the centre does not move) while
-the clock holds or while its own reference stands still; and the clock slows
-before each corner of the reference, so the robot reaches it slowly enough to
-turn (:func:`corner_caps`).
+Where its reference goes more than 90 degrees from its heading (a reversal, the
+start facing away), the robot drives the other way round (heading theta + pi,
+the lead point e behind), so it never follows more than 90 degrees off; the
+clock is capped so that following stays within the yaw-rate limit
+(:func:`creep_rate`) and slows before each corner of the reference, so the
+robot reaches it slowly enough to turn (:func:`corner_caps`). A robot turns in
+place (v = 0: the centre does not move) only while its own reference stands
+still, towards its next move, and after the plan's end, to its final heading.
 """
 
 from dataclasses import dataclass
@@ -30,20 +33,24 @@ import numpy as np
 # The lead e as a fraction of the tracking tolerance delta (capped by the clock's
 # fractions, see lead()): small enough that the start (E = 2e) runs at full rate.
 LEAD_FRACTION = 0.1
-# Largest lead (m): a wider one swings the lead point far out in a turn in place.
+# Largest lead (m): a wider one moves the lead point far in a turn in place or a switch of
+# driving direction (2e).
 MAX_LEAD = 0.05
 # The steering length (m): the heading turns toward the lead point's error within
 # about STEERING / v seconds, slower than a base's latency (200 ms at 0.3 m/s: 6 cm).
 STEERING = 0.1
-# Misalignment (rad) beyond which a robot turns in place instead of following.
-TURN_ANGLE = np.pi / 4
-# A turn in place ends once the heading is this close (rad) to the one it needs.
+# Misalignment (rad) beyond which a robot drives the other way round: it then never follows
+# more than 90 degrees off. Turning in place at corners instead (beyond 45 degrees, with
+# the fleet at rest) took the 20-robot bench 1.73x the holonomic run, this 1.24x
+# (doc/design.md section 13).
+REVERSE_ANGLE = np.pi / 2
+# A turn in place (while the reference stands still) ends this close (rad) to its heading.
 ALIGNED = 0.1
 # Fraction of the yaw-rate limit the clock leaves the lead point's sideways motion.
 CREEP = 1.0
 # Plan time (s) over which the clock slows into a corner ahead, from full rate.
 LOOKAHEAD = 1.0
-# The rate at which the reference passes a corner that needs a turn in place.
+# The rate at which the reference passes a corner where the robot switches direction.
 CORNER_RATE = 0.1
 # Gain (1/s) of the turns in place, on the heading error: its braking, 4 x 1.9 rad/s^2,
 # stays within a TurtleBot's yaw acceleration, and 4 x 200 ms latency does not ring.
@@ -67,10 +74,10 @@ def lead(tolerance: float, slow_fraction: float, hold_fraction: float) -> float:
     """
     Return the lead e (m) of the tracked point ahead of the centre.
 
-    e <= (hold_fraction - slow_fraction) delta / 2: a turn in place, begun with
-    E <= hold_fraction delta - 2e, raises E by at most 2e (doc/design.md
-    section 13), so it never passes the hold threshold. At most MAX_LEAD (an
-    infinite tolerance: no bodies to meet).
+    e <= (hold_fraction - slow_fraction) delta / 2: a turn in place or a switch
+    of driving direction, begun with E <= hold_fraction delta - 2e, raises E by
+    at most 2e (doc/design.md section 13), so it never passes the hold
+    threshold. At most MAX_LEAD (an infinite tolerance: no bodies to meet).
     """
     fraction = min(LEAD_FRACTION, 0.5 * (hold_fraction - slow_fraction))
     return min(MAX_LEAD, fraction * float(tolerance))
@@ -160,12 +167,13 @@ def creep_rate(angles: np.ndarray, speeds: np.ndarray, steering_length: float,
 
     A reference moving at speed |r'| in a direction at angle alpha from the
     heading asks for the yaw rate rate |r'| |sin alpha| / l; the clock leaves
-    it CREEP times the limit. Beyond TURN_ANGLE the robot turns in place first: 0.
+    it CREEP times the limit. Beyond REVERSE_ANGLE the robot must switch its
+    driving direction first: 0.
     """
     sideways = np.asarray(speeds, dtype=float) * np.abs(np.sin(angles))
     allowed = CREEP * steering_length * yaw_rate_limit
     rates = np.minimum(1.0, allowed / np.maximum(sideways, np.finfo(float).tiny))
-    return np.where(np.abs(angles) > TURN_ANGLE, 0.0, rates)
+    return np.where(np.abs(angles) > REVERSE_ANGLE, 0.0, rates)
 
 
 class Corners:
@@ -197,18 +205,18 @@ class Corners:
 
     def turns(self, robots: np.ndarray) -> np.ndarray:
         """
-        Return the (M,) poses at which one of robots (k,) turns by more than TURN_ANGLE.
+        Return the (M,) poses at which one of robots (k,) turns by more than REVERSE_ANGLE.
 
         Between two consecutive moves of a robot (the intervals between them
-        may stand still), at the start of the second one: there it turns in
-        place or switches its driving direction.
+        may stand still), at the start of the second one: there it switches
+        its driving direction.
         """
         result = np.zeros(self.seconds.size, dtype=bool)
         for robot in np.flatnonzero(robots):
             moves = np.flatnonzero(self.speeds[:, robot] > STILL)
             directions = self.velocities[moves, robot]
             beta = wrap(np.diff(np.arctan2(directions[:, 1], directions[:, 0])))
-            result[moves[1:][np.abs(beta) > TURN_ANGLE]] = True
+            result[moves[1:][np.abs(beta) > REVERSE_ANGLE]] = True
         return result
 
     def interval(self, s: float) -> int:
@@ -244,11 +252,11 @@ class Corners:
         A corner is a breakpoint at plan time t in (s, s + LOOKAHEAD] where robot i's
         reference moves before and turns by beta, or stops (the plan's end too):
         a base with an acceleration limit cannot stop at once either. It must be
-        passed at most at creep_rate(beta) (CORNER_RATE if beta needs a turn in
-        place or the reference stops), and the cap rises linearly to 1 over
+        passed at most at creep_rate(beta) (CORNER_RATE if beta needs a switch
+        of direction or the reference stops), and the cap rises linearly to 1 over
         LOOKAHEAD plan seconds before it. A reference timed under acceleration
         limits (rests) brakes into its stops at those limits, and its turns
-        beyond TURN_ANGLE are stops (Execution): there only the creep corners
+        beyond REVERSE_ANGLE are stops (Execution): there only the creep corners
         are left to slow into.
         """
         k = self.speeds.shape[1] if self.speeds.size else 0
