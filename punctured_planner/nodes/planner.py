@@ -334,7 +334,8 @@ class PlannerNode(Node):
         """
         messages = publications.plan_messages(outcome, settings)
         publishers = [self._publisher(m.topic, m.msg_type) for m in messages]
-        stale = [name for name in self._latched_names if name not in set(outcome.names)]
+        planned = set(outcome.names)
+        stale = [name for name in self._latched_names if name not in planned]
         paths = len(outcome.names)
         for publisher, message in zip(publishers[:paths], messages[:paths]):
             publisher.publish(message.data)
