@@ -83,7 +83,7 @@ def test_invalid_parameters_stop_the_node(planner_process, arguments):
 
 
 def test_renamed_node_keeps_its_companion_apart(planner_process, ros_client):
-    """Under -r __node:=NAME (a launch name=) the inputs node is NAME_inputs, not NAME twice."""
+    """Under -r __node:=NAME (a launch name=) the companions are NAME_inputs, NAME_outputs."""
     from punctured_planner_interfaces.srv import PlanSequence
     node = planner_process('-r', '__node:=fleet_planner')
     client = ros_client.node.create_client(PlanSequence, node.name('plan_sequence'))
@@ -93,6 +93,35 @@ def test_renamed_node_keeps_its_companion_apart(planner_process, ros_client):
     def names():
         return [name for name, ns in ros_client.node.get_node_names_and_namespaces()
                 if ns == namespace]
-    assert ros_client.spin_until(lambda: len(names()) >= 2, 10), names()
-    assert sorted(names()) == ['fleet_planner', 'fleet_planner_inputs']
+    assert ros_client.spin_until(lambda: len(names()) >= 3, 10), names()
+    assert sorted(names()) == ['fleet_planner', 'fleet_planner_inputs', 'fleet_planner_outputs']
+    assert node.stop() == 0, node.log()
+
+
+def test_a_path_subscriber_with_incompatible_qos_is_warned_about(planner_process, ros_client):
+    """
+    A subscriber to a robot's path that asks for a deadline: the node logs rclpy's warning.
+
+    The path publishers' QoS event handlers are spun on the outputs node's thread
+    (nodes/planner.py): they still fire, naming the topic and the policy.
+    """
+    from nav_msgs.msg import Path
+    from punctured_planner.ros.qos import LATCHED
+    from punctured_planner_interfaces.srv import PlanSequence
+    from rclpy.duration import Duration
+    from rclpy.qos import QoSProfile
+    node = planner_process(params_file=SCENARIO)
+    client = ros_client.node.create_client(PlanSequence, node.name('plan_sequence'))
+    ros_client.wait_for_service(client)
+    response = ros_client.call(client, example_request())
+    assert response.error_code == PlanSequence.Response.NONE, response.error_msg + node.log()
+    # The latched writers offer no deadline: a reader that requires one is incompatible.
+    demanding = QoSProfile(depth=1, reliability=LATCHED.reliability,
+                           durability=LATCHED.durability, deadline=Duration(seconds=1))
+    ros_client.node.create_subscription(Path, node.name('robot_3/plan'), lambda _: None,
+                                        demanding)
+    # rclpy names the topic as the node created it: relative.
+    warning = "New subscription discovered on topic 'robot_3/plan', requesting incompatible QoS"
+    assert ros_client.spin_until(lambda: warning in node.log(), 20), node.log()
+    assert 'Last incompatible policy: DEADLINE' in node.log()
     assert node.stop() == 0, node.log()

@@ -283,8 +283,11 @@ class Plan:
         new = np.ones(values.size, dtype=bool)
         new[1:] = (values[1:] != values[:-1]) | np.any(
             self.positions[1:] != self.positions[:-1], axis=(1, 2))
+        # resample uses the profile only to stamp samples inside the legs: with none,
+        # every stamp is a breakpoint's own.
         profile = (self.profile(max_speed, max_acceleration, self.positions[new])
-                   if max_speed is not None and max_acceleration > 0 else None)
+                   if max_speed is not None and max_acceleration > 0 and samples_per_leg > 0
+                   else None)
         values, positions, _ = resample(values[new], self.positions[new], samples_per_leg,
                                         profile)
         kept = np.cumsum(new) - 1

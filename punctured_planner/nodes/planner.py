@@ -24,13 +24,22 @@ the subscriptions. Not rclpy's MultiThreadedExecutor: in rclpy 7.1 it busy-
 loops on subscription traffic (ros2/rclpy#1223, #1452), and measured here, with
 obstacles and robot states at 50 Hz, service round trips went from 4 ms to 80
 ms median with stalls of 2-6 s (two single-threaded executors: 3.4 ms, worst 6
-ms). A plan is answered first; then the request's outcome is logged and the
-plan published, complete, in the order msg_docs/topics.md gives. Start and stop (Ctrl-C and
-SIGTERM alike, threads joined before anything is destroyed):
+ms). The publishers live on a third node, ``<name>_outputs``, spun by a third
+thread, which wakes only when one of their QoS events fires (rclpy's default
+handlers log a subscriber with incompatible QoS or type, two per publisher).
+rclpy 7.1's executor looks each waitable of its nodes up in a plain list after
+every wake-up: with one latched Path per robot, 1,026 waitables cost 7.7 ms per
+wake-up against 0.07 ms for 2 (measured), about 6 ms per request at k = 512 on
+the service's executor; on the inputs node, which wakes with every message of
+its 50 Hz streams, that would be most of a core. A plan is answered first;
+then the request's outcome is logged and the plan published, complete, in the
+order msg_docs/topics.md gives. Start and stop (Ctrl-C and SIGTERM alike,
+threads joined before anything is destroyed):
 :func:`punctured_planner.ros.runtime.run_nodes`.
 """
 
 from dataclasses import dataclass
+import gc
 import sys
 import threading
 import traceback
@@ -97,12 +106,10 @@ class PlannerNode(Node):
         self._settings: PlannerSettings = self._node_parameters.settings
         self._obstacles = self._parameter_obstacles(self._settings)
 
-        # The subscriptions' own node: spun apart from the service (module docstring).
-        # A local __node remap outranks a global one (-r __node:=NAME, launch name=).
-        inputs_name = self.get_name() + '_inputs'
-        self.inputs = Node(inputs_name, context=self.context, namespace=self.get_namespace(),
-                           cli_args=['--ros-args', '-r', '__node:=' + inputs_name],
-                           start_parameter_services=False)
+        # The subscriptions' and the publishers' own nodes: spun apart from the
+        # service (module docstring).
+        self.inputs = self._companion('inputs')
+        self.outputs = self._companion('outputs')
         self.inputs.create_subscription(PoseArray, 'obstacles', self._on_obstacles, LATCHED)
         self.inputs.create_subscription(PoseArray, 'robot_states', self._on_robot_states,
                                         STATE)
@@ -127,6 +134,14 @@ class PlannerNode(Node):
             % (self.resolve_service_name('plan_sequence'), s.frame_id, s.dimension,
                s.core_variant, s.robot_radius, self._obstacles.describe(),
                ', '.join(s.robot_names) or (str(s.robot_count) if s.robot_count else 'any')))
+
+    def _companion(self, role: str) -> Node:
+        """Return the companion node ``<name>_<role>``: same namespace and context."""
+        # A local __node remap outranks a global one (-r __node:=NAME, launch name=).
+        name = '%s_%s' % (self.get_name(), role)
+        return Node(name, context=self.context, namespace=self.get_namespace(),
+                    cli_args=['--ros-args', '-r', '__node:=' + name],
+                    start_parameter_services=False)
 
     # ------------------------------------------------------------ parameters
 
@@ -202,6 +217,19 @@ class PlannerNode(Node):
     # ------------------------------------------------------------ the service
 
     def _on_plan_sequence(self, request, response):
+        # Answer first, collect after: the cyclic collector stays off until the reply is
+        # sent (_send_response). A plan's messages are many objects (k x M poses), and a
+        # full collection scanning them took 24-40 ms inside the reply of one call in
+        # three at k = 512 (doc/design.md section 11); reference counting still frees.
+        gc.disable()
+        try:
+            return self._plan_request(request, response)
+        except BaseException:
+            gc.enable()
+            raise
+
+    def _plan_request(self, request, response):
+        """Plan one request against a snapshot; keep what to log and publish after the reply."""
         now_ns = self.get_clock().now().nanoseconds
         snapshot = self.snapshot()
         self._request_count += 1
@@ -253,6 +281,7 @@ class PlannerNode(Node):
         try:
             self._send_attempts(response, header, number, sequence)
         finally:
+            gc.enable()
             after, self._after_reply = self._after_reply, None
             if after is not None:
                 self._log_outcome(after)
@@ -305,7 +334,8 @@ class PlannerNode(Node):
         """
         messages = publications.plan_messages(outcome, settings)
         publishers = [self._publisher(m.topic, m.msg_type) for m in messages]
-        stale = [name for name in self._latched_names if name not in set(outcome.names)]
+        planned = set(outcome.names)
+        stale = [name for name in self._latched_names if name not in planned]
         paths = len(outcome.names)
         for publisher, message in zip(publishers[:paths], messages[:paths]):
             publisher.publish(message.data)
@@ -326,18 +356,18 @@ class PlannerNode(Node):
             self.get_logger().error('could not retract the partial plan: %r' % error)
 
     def _publisher(self, topic, msg_type):
-        """Return the latched publisher of a relative topic, created on first use."""
+        """Return the latched publisher of a relative topic (on the outputs node), made once."""
         publisher = self._latched_publishers.get(topic)
         if publisher is None:
-            publisher = self.create_publisher(msg_type, topic, LATCHED)
+            publisher = self.outputs.create_publisher(msg_type, topic, LATCHED)
             self._latched_publishers[topic] = publisher
         return publisher
 
 
 def planner_nodes(context=None, **kwargs) -> NodeGroup:
-    """Return the PlannerNode and its inputs node: each spun in its own thread."""
+    """Return the PlannerNode, its inputs and its outputs node: each spun in its own thread."""
     node = PlannerNode(context=context, **kwargs)
-    return NodeGroup([node, node.inputs])
+    return NodeGroup([node, node.inputs, node.outputs])
 
 
 def main(args=None):

@@ -279,6 +279,22 @@ def header(frame_id, stamp_ns):
     return message
 
 
+def point_list(xyz):
+    """
+    Return geometry_msgs/Points of (N, 3) values, each filled in place (as :func:`_filled`).
+
+    The markers draw every breakpoint of every robot: Point's constructor, with
+    its keyword handling and checks, cost most of their building.
+    """
+    new = object.__new__
+    result = []
+    for x, y, z in np.asarray(xyz, dtype=float).tolist():
+        point = new(Point)
+        point._x, point._y, point._z, point._check_fields = x, y, z, False
+        result.append(point)
+    return result
+
+
 def pose(position, orientation=IDENTITY):
     """Return a geometry_msgs/Pose at position (3,) with orientation (x, y, z, w)."""
     x, y, z = np.asarray(position, dtype=float).tolist()

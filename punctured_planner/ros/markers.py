@@ -12,7 +12,6 @@ robots' discs at each C_m, translucent, of diameter 2 robot_radius).
 
 from dataclasses import dataclass
 
-from geometry_msgs.msg import Point
 from geometry_msgs.msg import Vector3
 import numpy as np
 from std_msgs.msg import ColorRGBA
@@ -21,6 +20,7 @@ from visualization_msgs.msg import Marker
 from visualization_msgs.msg import MarkerArray
 
 from .conversions import header
+from .conversions import point_list
 from .conversions import robot_names
 from .conversions import to_xyz
 
@@ -45,10 +45,6 @@ def _rgba(r, g, b, a):
     return ColorRGBA(r=r, g=g, b=b, a=a)
 
 
-def _points(xyz):
-    return [Point(x=x, y=y, z=z) for x, y, z in np.asarray(xyz, dtype=float).tolist()]
-
-
 @dataclass(frozen=True)
 class _Drawing:
     """What every marker of one plan shares: header, plane, scale."""
@@ -62,7 +58,7 @@ class _Drawing:
         item = Marker(header=self.header, ns=ns, id=marker_id, type=kind, action=Marker.ADD,
                       scale=Vector3(x=size, y=size, z=size), color=colour)
         item.pose.orientation.w = 1.0
-        item.points = _points(points) if len(points) else []
+        item.points = point_list(points) if len(points) else []
         return item
 
 
