@@ -185,14 +185,6 @@ class _Knots:
         return (1.0 - f) * values[self.interval] + f * values[self.interval + 1]
 
 
-def _length(vectors):
-    """Return the lengths (...) of vectors (..., d); a sum per coordinate is faster."""
-    squared = vectors[..., 0] * vectors[..., 0]
-    for axis in range(1, vectors.shape[-1]):
-        squared += vectors[..., axis] * vectors[..., axis]
-    return np.sqrt(squared, out=squared)
-
-
 def _interval_boxes(planes, points):
     """
     Return (low, high), each (d, N - 1, k): every robot's bounding box over each knot interval.
@@ -479,12 +471,24 @@ def _knot_caps(bound, reduce=np.minimum):
     return caps
 
 
+def _knots_last(values):
+    """
+    Return knot values (N, k, d) as the sweeps' contiguous (d, k, N) array.
+
+    Every row is one coordinate of one robot over all knots: adding a knot's
+    common part broadcasts over whole rows (with d last, each inner loop would
+    be d = 2 long), and the mean over the robots (axis 1) adds them one by one,
+    in the order it takes over (N, k, d), so the values are the same.
+    """
+    return np.ascontiguousarray(np.transpose(values, (2, 1, 0)))
+
+
 def _clipped(move, caps):
-    """Return the moves (..., d) scaled down to lengths <= caps (...); zero at cap 0."""
-    length = _length(move)
+    """Return the moves (d, ...) scaled down to lengths <= caps (...), in place; 0 at cap 0."""
+    length = _planes_length(move)
     over = length > caps
-    scale = np.divide(caps, length, out=np.ones_like(length), where=over)
-    return move * scale[..., None]
+    move *= np.divide(caps, length, out=np.ones_like(length), where=over)
+    return move
 
 
 class _Block:
@@ -497,7 +501,8 @@ class _Block:
     cap (0 where a pair has no slack, so rounding cannot take any); |own| <=
     the pair cap, <= what common leaves of the pillar cap and <= step. Both
     are totals over the block, so a robot's displacement at any instant of the
-    block stays within its caps (design, 14).
+    block stays within its caps (design, 14). Moves are in the sweeps' layout
+    (_knots_last): common (d, 1, N), own (d, k, N).
     """
 
     def __init__(self, caps, step):
@@ -507,27 +512,30 @@ class _Block:
         # smallest pair cap does that and stays continuous.
         self.common_cap = np.minimum(np.minimum(0.5 * caps.pillar.min(axis=1), step),
                                      _TRANSLATION * caps.pair.min(axis=1))
-        self.pair, self.pillar, self.step = caps.pair, caps.pillar, step
-        self.lower, self.upper = caps.lower, caps.upper
-        if self.lower is not None:
+        self.pair, self.pillar, self.step = caps.pair.T, caps.pillar.T, step
+        self.lower = self.upper = None
+        if caps.lower is not None:
+            self.lower, self.upper = _knots_last(caps.lower), _knots_last(caps.upper)
             # The common part stays within every robot's range along each axis.
-            self.common_range = (-self.lower.min(axis=1), self.upper.min(axis=1))
+            self.common_range = (-self.lower.min(axis=1, keepdims=True),
+                                 self.upper.min(axis=1, keepdims=True))
 
     def clip(self, wanted):
         """
-        Return (common (N, d), own (N, k, d)): the wanted totals (N, k, d) within the caps.
+        Return (common (d, 1, N), own (d, k, N)): the wanted totals (d, k, N) within the caps.
 
-        common is the fleet's mean, clipped; own what each robot still wants, clipped.
+        common is the fleet's mean, clipped; own what each robot still wants,
+        clipped (wanted is overwritten).
         """
-        common = _clipped(wanted.mean(axis=1), self.common_cap)
+        common = _clipped(wanted.mean(axis=1, keepdims=True), self.common_cap)
         if self.lower is not None:
             # Within every robot's wall limits, so each robot's own part has room around 0.
             common = np.clip(common, *self.common_range)
-        left = self.pillar - _length(common)[:, None]
-        own = _clipped(wanted - common[:, None], np.minimum(np.minimum(self.pair, left),
-                                                            self.step))
+        left = self.pillar - _planes_length(common)
+        own = _clipped(np.subtract(wanted, common, out=wanted),
+                       np.minimum(np.minimum(self.pair, left), self.step))
         if self.lower is not None:
-            own = np.clip(own, -self.lower - common[:, None], self.upper - common[:, None])
+            own = np.clip(own, -self.lower - common, self.upper - common)
         return common, own
 
 
@@ -539,22 +547,23 @@ def _sweep(origin, common, own, block):
     split into the fleet's mean and each robot's own part; knots of one parity
     have no neighbour of the same parity, so each half sweep uses the other
     half's newest values. origin is where the block starts: the construction's
-    knots plus the field so far, in that order.
+    knots plus the field so far, in that order (all in the layout _knots_last).
     """
+    current = np.empty_like(origin)
     for parity in (1, 0):
-        current = origin + common[:, None]
+        np.add(origin, common, out=current)
         current += own
         # The knots of this parity (slices: views, not gathers) and their two neighbours.
         first = parity + (1 - parity) * 2
-        index = slice(first, current.shape[0] - 1, 2)
+        index = slice(first, current.shape[2] - 1, 2)
         before, after = slice(first - 1, -2, 2), slice(first + 1, None, 2)
         # RELAXATION x (the neighbours' midpoint - the knot), in place.
-        move = current[before] + current[after]
+        move = current[..., before] + current[..., after]
         move *= 0.5
-        move -= current[index]
+        move -= current[..., index]
         move *= RELAXATION
-        wanted = common[:, None] + own
-        wanted[index] += move
+        wanted = common + own
+        wanted[..., index] += move
         common, own = block.clip(wanted)
     return common, own
 
@@ -600,8 +609,9 @@ def refine(times: np.ndarray, positions: np.ndarray, waypoint_indices: np.ndarra
     bodies = Bodies(bodies.obstacles, bodies.radii, min(bodies.margin, gap), bodies.rounding,
                     bodies.bounds)
     scale = fleet_scale(configurations, bodies.obstacles)
-    base_knots = union.positions[knots.points]
-    values = np.zeros((knots.times.size, k, d))
+    base_knots = _knots_last(union.positions[knots.points])
+    # The field's values at the knots, in the sweeps' layout (d, k, N).
+    values = np.zeros_like(base_knots)
     motion = union.positions
     step = STEP * scale
     for block_index in range(blocks):
@@ -609,14 +619,14 @@ def refine(times: np.ndarray, positions: np.ndarray, waypoint_indices: np.ndarra
             nearest = _Nearest.of(motion, knots, bodies)
         caps = _Caps(nearest, knots, bodies, step)
         block = _Block(caps, step)
-        common, own = ((np.zeros((values.shape[0], d)), np.zeros_like(values))
-                       if caps.inward is None else block.clip(caps.inward))
+        common, own = ((np.zeros((d, 1, values.shape[2])), np.zeros_like(values))
+                       if caps.inward is None else block.clip(_knots_last(caps.inward)))
         origin = base_knots + values
         for _ in range(SWEEPS):
             common, own = _sweep(origin, common, own, block)
-        values = values + common[:, None] + own
+        values = values + common + own
         # x + 0.0 is x: a robot held everywhere in an interval keeps x's breakpoints.
-        motion = union.positions + knots.field(values)
+        motion = union.positions + knots.field(np.transpose(values, (2, 1, 0)))
     motion[union.waypoint_indices] = configurations
     return Refinement(union.times, motion, union.waypoint_indices, union.base_legs,
                       bodies.margin)
