@@ -486,8 +486,12 @@ def _knots_last(values):
 def _clipped(move, caps):
     """Return the moves (d, ...) scaled down to lengths <= caps (...), in place; 0 at cap 0."""
     length = _planes_length(move)
-    over = length > caps
-    move *= np.divide(caps, length, out=np.ones_like(length), where=over)
+    # caps / length where a move is longer than its cap, else 1: the quotient rounds to
+    # >= 1 wherever length <= caps, and fmin takes 1 for the 0 / 0 of a zero move at cap 0
+    # (a masked division costs three times as much).
+    with np.errstate(divide='ignore', invalid='ignore'):
+        scale = np.divide(caps, length, out=length)
+    move *= np.fmin(scale, 1.0, out=scale)
     return move
 
 
@@ -512,7 +516,8 @@ class _Block:
         # smallest pair cap does that and stays continuous.
         self.common_cap = np.minimum(np.minimum(0.5 * caps.pillar.min(axis=1), step),
                                      _TRANSLATION * caps.pair.min(axis=1))
-        self.pair, self.pillar, self.step = caps.pair.T, caps.pillar.T, step
+        self.pair, self.pillar = caps.pair.T, caps.pillar.T
+        self.own_cap = np.minimum(self.pair, step)
         self.lower = self.upper = None
         if caps.lower is not None:
             self.lower, self.upper = _knots_last(caps.lower), _knots_last(caps.upper)
@@ -527,13 +532,14 @@ class _Block:
         common is the fleet's mean, clipped; own what each robot still wants,
         clipped (wanted is overwritten).
         """
-        common = _clipped(wanted.mean(axis=1, keepdims=True), self.common_cap)
+        # The mean: the sum over the robots divided by k, as np.mean takes it.
+        common = _clipped(np.add.reduce(wanted, axis=1, keepdims=True) / wanted.shape[1],
+                          self.common_cap)
         if self.lower is not None:
             # Within every robot's wall limits, so each robot's own part has room around 0.
             common = np.clip(common, *self.common_range)
         left = self.pillar - _planes_length(common)
-        own = _clipped(np.subtract(wanted, common, out=wanted),
-                       np.minimum(np.minimum(self.pair, left), self.step))
+        own = _clipped(np.subtract(wanted, common, out=wanted), np.minimum(self.own_cap, left))
         if self.lower is not None:
             own = np.clip(own, -self.lower - common, self.upper - common)
         return common, own
