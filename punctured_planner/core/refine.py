@@ -40,6 +40,7 @@ from functools import lru_cache
 import numpy as np
 
 from .certificate import certify, evaluates_every_pair, segment_minimum
+from .pairs import point_pairs
 from .walls import wall_slack
 
 # Knots per segment: the field is piecewise linear on the j / KNOTS fractions.
@@ -278,18 +279,21 @@ def _near_pillars(planes, points, runs, pillars, offsets, margin):
     """
     firsts = np.array([first for first, _ in runs])
     lasts = np.array([last for _, last in runs])
-    centres = pillars.T[:, None, None, :]
-    knots = planes[:, points[firsts[0]:lasts[-1]], :, None]
-    nearest = (_planes_length(knots - centres) - offsets).min(axis=2)
+    # Pillars ahead of the robots, (d, r, ..., k): every broadcast runs along the k robots,
+    # not along a few pillars.
+    centres = pillars.T[:, :, None, None]
+    pillar_offsets = offsets.T[:, None]
+    knots = planes[:, None, points[firsts[0]:lasts[-1]]]
+    nearest = (_planes_length(knots - centres) - pillar_offsets).min(axis=0)
     near = np.maximum.reduceat(nearest, firsts - firsts[0], axis=0) + margin
     begins, ends = points[firsts], points[lasts]
     piece = planes[:, begins[0]:ends[-1] + 1]
     low = np.minimum(np.minimum.reduceat(piece, begins - begins[0], axis=1), planes[:, ends])
     high = np.maximum(np.maximum.reduceat(piece, begins - begins[0], axis=1), planes[:, ends])
-    gap = np.maximum(low[..., None] - centres, centres - high[..., None])
+    gap = np.maximum(low[:, None] - centres, centres - high[:, None])
     np.maximum(gap, 0.0, out=gap)
-    keep = _planes_length(gap) - offsets - margin <= near[:, :, None]
-    return keep.reshape(len(runs), -1)
+    keep = _planes_length(gap) - pillar_offsets - margin <= near
+    return np.transpose(keep, (1, 2, 0)).reshape(len(runs), -1)
 
 
 def _interval_minima(planes, knots, pillars=None, offsets=None):
@@ -308,7 +312,7 @@ def _interval_minima(planes, knots, pillars=None, offsets=None):
     """
     d, _, k = planes.shape
     # Robot pairs a < b only (np.take keeps the pairs last and contiguous).
-    a, b = np.triu_indices(k, 1)
+    a, b = point_pairs(k)
     width = a.size if pillars is None else k * pillars.shape[0]
     points = knots.points
     minima = np.full((points.size - 1, width), np.inf)
@@ -389,7 +393,7 @@ class _Nearest:
         legs = np.concatenate([np.arange(points[0]), np.arange(points[-1], breakpoints - 1)])
         gaps = [np.inf]
         if self.robots is not None:
-            a, b = np.triu_indices(k, 1)
+            a, b = point_pairs(k)
             ends = self.planes[:, np.concatenate([legs, legs + 1])]
             relative = np.take(ends, a, axis=2) - np.take(ends, b, axis=2)
             squared, _ = segment_minimum(relative[:, :legs.size],
