@@ -38,8 +38,8 @@ _CHUNK_ELEMENTS = 1 << 22
 # four times slower (fresh pages for every temporary).
 _PASS_ELEMENTS = 1 << 16
 # Legs per run of the exact pair filter (_near_runs): boxes over fewer legs prune more
-# pairs, each run costs a pass of its own (on a refined 40-robot plan 16 legs kept 3 - 9%
-# of the pairs' runs).
+# pairs, each run costs a pass of its own (with 16 legs, 40-robot plans keep 3 - 6% of
+# the pairs' runs refined, 8 - 11% unrefined).
 _RUN_LEGS = 16
 # The pair filter's allowance for rounding, as a share of the coordinate and radius
 # scale: the closed form and the bounds each round to a few ulps of it, 1e5 times less.
