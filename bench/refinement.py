@@ -16,10 +16,13 @@ RRTConnect (2 s per segment) with path simplification (1 s) plans the same
 fleets for small k (it does not solve larger ones in its budget), its discs
 validity check in Python; its time is given with and without that checker.
 
-Run alone: ``.venv/bin/python bench/refinement.py [--quick]``.
+Run alone: ``.venv/bin/python bench/refinement.py [--quick] [--k K ...]``;
+``--k 40`` plans only fleets of 40 robots (in every dimension of the grid, with
+its seeds), ``--quick --k 40`` with the smoke run's.
 """
 
-from dataclasses import dataclass, field
+import argparse
+from dataclasses import dataclass, field, replace
 import sys
 import time
 
@@ -301,8 +304,18 @@ def report(settings):
 
 
 def main(argv=None):
-    """Run the benchmark and print its figures."""
-    grid_main(__doc__, report, quick_settings, Settings, argv)
+    """Run the benchmark and print its figures (--k: only those fleet sizes)."""
+    parser = argparse.ArgumentParser(add_help=False)
+    parser.add_argument('--k', type=int, nargs='+', help='fleet sizes to run (default: all)')
+    chosen, rest = parser.parse_known_args(argv)
+
+    def only(settings):
+        if not chosen.k:
+            return settings
+        return replace(settings, ks={d: tuple(chosen.k) for d in settings.ks},
+                       rrt_ks=tuple(k for k in settings.rrt_ks if k in chosen.k))
+
+    grid_main(__doc__, report, lambda: only(quick_settings()), lambda: only(Settings()), rest)
 
 
 if __name__ == '__main__':

@@ -40,6 +40,7 @@ from functools import lru_cache
 import numpy as np
 
 from .certificate import certify, evaluates_every_pair, segment_minimum
+from .pairs import point_pairs
 from .walls import wall_slack
 
 # Knots per segment: the field is piecewise linear on the j / KNOTS fractions.
@@ -162,12 +163,19 @@ def union_motion(times: np.ndarray, positions: np.ndarray,
 
 @dataclass(frozen=True, eq=False)
 class _Knots:
-    """The knots: times (N,), each breakpoint's knot interval (U,), fraction, index in U."""
+    """
+    The knots: times (N,), each breakpoint's knot interval (U,), fraction, index in U.
+
+    partners (N - 1, k), None for one robot: each robot's nearest other robot
+    at the first knot of each interval in the construction's motion, the one
+    the pair filter measures it against in every block (_near_pairs).
+    """
 
     times: np.ndarray
     interval: np.ndarray
     fraction: np.ndarray
     points: np.ndarray
+    partners: np.ndarray | None
 
     @classmethod
     def of(cls, union: _Union, knots: np.ndarray) -> '_Knots':
@@ -177,20 +185,14 @@ class _Knots:
         fraction = (union.times - knots[interval]) / (knots[interval + 1] - knots[interval])
         # Every knot is a breakpoint of the union.
         points = np.searchsorted(union.times, knots)
-        return cls(knots, interval, np.clip(fraction, 0.0, 1.0), points)
+        partners = (_knot_partners(np.moveaxis(union.positions[points[:-1]], 2, 0))
+                    if union.positions.shape[1] > 1 else None)
+        return cls(knots, interval, np.clip(fraction, 0.0, 1.0), points, partners)
 
     def field(self, values: np.ndarray) -> np.ndarray:
         """Return (U, k, d) the field at the breakpoints from its values (N, k, d) at knots."""
         f = self.fraction[:, None, None]
         return (1.0 - f) * values[self.interval] + f * values[self.interval + 1]
-
-
-def _length(vectors):
-    """Return the lengths (...) of vectors (..., d); a sum per coordinate is faster."""
-    squared = vectors[..., 0] * vectors[..., 0]
-    for axis in range(1, vectors.shape[-1]):
-        squared += vectors[..., axis] * vectors[..., axis]
-    return np.sqrt(squared, out=squared)
 
 
 def _interval_boxes(planes, points):
@@ -238,6 +240,34 @@ def _pair_minimum(values, k):
     return result
 
 
+def _knot_partners(knots):
+    """
+    Return (M, k) each robot's nearest other robot in each of M configurations (d, M, k).
+
+    Of several at the same distance any one; every robot gets another robot
+    (the next one where no distance equals the smallest), and any other robot
+    keeps the filter exact. Squares too large for floats are inf: a partner
+    all the same.
+    """
+    d, count, k = knots.shape
+    a, b = point_pairs(k)
+    partners = np.empty((count, k), dtype=np.intp)
+    partners[:] = (np.arange(k) + 1) % k
+    # About _FILTER_ENTRIES entries at a time.
+    rows = max(1, _FILTER_ENTRIES // (d * a.size))
+    for first in range(0, count, rows):
+        piece = knots[:, first:first + rows]
+        with np.errstate(over='ignore'):
+            distance = _planes_length(np.take(piece, a, axis=2) - np.take(piece, b, axis=2))
+        nearest = _pair_minimum(distance, k)
+        found = partners[first:first + rows]
+        # A pair at a robot's smallest distance names its partner.
+        for mine, other in ((a, b), (b, a)):
+            row, pair = np.nonzero(distance == np.take(nearest, mine, axis=1))
+            found[row, mine[pair]] = other[pair]
+    return partners
+
+
 def _runs(points, legs):
     """Return [(first, last), ...]: runs of whole knot intervals of about legs legs each."""
     runs, first, intervals = [], 0, points.size - 1
@@ -249,22 +279,26 @@ def _runs(points, legs):
     return runs
 
 
-def _near_pairs(planes, points, runs, a, b, margin):
+def _near_pairs(planes, points, runs, a, b, margin, partners):
     """
     Return (runs, pairs) whether each pair can hold a robot's smallest distance in each run.
 
-    In every interval each robot comes within its nearest partner's distance at
-    the interval's first knot (plus margin, far above rounding); a pair whose
-    boxes over the run stay farther apart than the largest of those for both
-    of its robots is never the smallest of either, so the pairs kept give
+    In every interval each robot comes within its partner's distance at the
+    interval's first knot (plus margin, far above rounding): the motion passes
+    through that knot. Any other robot would do; partners (N - 1, k) are the
+    nearest there in the construction's motion (_Knots), which stay near over
+    the blocks (a 40-robot plan keeps 16 - 17% of the pairs against 16% for
+    the nearest in each block, found over every pair at every knot). A pair
+    whose boxes over the run stay farther apart than the largest of those for
+    both of its robots is never the smallest of either, so the pairs kept give
     every robot's very minimum.
     """
     firsts = np.array([first for first, _ in runs])
     lasts = np.array([last for _, last in runs])
     knots = planes[:, points[firsts[0]:lasts[-1]]]
-    nearest = _pair_minimum(
-        _planes_length(np.take(knots, a, axis=2) - np.take(knots, b, axis=2)), planes.shape[2])
-    near = np.maximum.reduceat(nearest, firsts - firsts[0], axis=0) + margin
+    partner = np.take_along_axis(knots, partners[None, firsts[0]:lasts[-1]], axis=2)
+    near = np.maximum.reduceat(_planes_length(knots - partner), firsts - firsts[0], axis=0)
+    near += margin
     begins, ends = points[firsts], points[lasts]
     piece = planes[:, begins[0]:ends[-1] + 1]
     # The motion is linear between breakpoints: their box over a run holds all of it.
@@ -286,18 +320,21 @@ def _near_pillars(planes, points, runs, pillars, offsets, margin):
     """
     firsts = np.array([first for first, _ in runs])
     lasts = np.array([last for _, last in runs])
-    centres = pillars.T[:, None, None, :]
-    knots = planes[:, points[firsts[0]:lasts[-1]], :, None]
-    nearest = (_planes_length(knots - centres) - offsets).min(axis=2)
+    # Pillars ahead of the robots, (d, r, ..., k): every broadcast runs along the k robots,
+    # not along a few pillars.
+    centres = pillars.T[:, :, None, None]
+    pillar_offsets = offsets.T[:, None]
+    knots = planes[:, None, points[firsts[0]:lasts[-1]]]
+    nearest = (_planes_length(knots - centres) - pillar_offsets).min(axis=0)
     near = np.maximum.reduceat(nearest, firsts - firsts[0], axis=0) + margin
     begins, ends = points[firsts], points[lasts]
     piece = planes[:, begins[0]:ends[-1] + 1]
     low = np.minimum(np.minimum.reduceat(piece, begins - begins[0], axis=1), planes[:, ends])
     high = np.maximum(np.maximum.reduceat(piece, begins - begins[0], axis=1), planes[:, ends])
-    gap = np.maximum(low[..., None] - centres, centres - high[..., None])
+    gap = np.maximum(low[:, None] - centres, centres - high[:, None])
     np.maximum(gap, 0.0, out=gap)
-    keep = _planes_length(gap) - offsets - margin <= near[:, :, None]
-    return keep.reshape(len(runs), -1)
+    keep = _planes_length(gap) - pillar_offsets - margin <= near
+    return np.transpose(keep, (1, 2, 0)).reshape(len(runs), -1)
 
 
 def _interval_minima(planes, knots, pillars=None, offsets=None):
@@ -316,7 +353,7 @@ def _interval_minima(planes, knots, pillars=None, offsets=None):
     """
     d, _, k = planes.shape
     # Robot pairs a < b only (np.take keeps the pairs last and contiguous).
-    a, b = np.triu_indices(k, 1)
+    a, b = point_pairs(k)
     width = a.size if pillars is None else k * pillars.shape[0]
     points = knots.points
     minima = np.full((points.size - 1, width), np.inf)
@@ -332,7 +369,8 @@ def _interval_minima(planes, knots, pillars=None, offsets=None):
             chosen = runs[run:run + batch]
             margin = _BOUND_SLACK * scale
             near[run:run + batch] = (
-                _near_pairs(planes, points, chosen, a, b, margin) if pillars is None else
+                _near_pairs(planes, points, chosen, a, b, margin, knots.partners)
+                if pillars is None else
                 _near_pillars(planes, points, chosen, pillars, offsets,
                               margin + _BOUND_SLACK * float(np.abs(offsets).max())))
     for run, (first, last) in enumerate(runs):
@@ -397,7 +435,7 @@ class _Nearest:
         legs = np.concatenate([np.arange(points[0]), np.arange(points[-1], breakpoints - 1)])
         gaps = [np.inf]
         if self.robots is not None:
-            a, b = np.triu_indices(k, 1)
+            a, b = point_pairs(k)
             ends = self.planes[:, np.concatenate([legs, legs + 1])]
             relative = np.take(ends, a, axis=2) - np.take(ends, b, axis=2)
             squared, _ = segment_minimum(relative[:, :legs.size],
@@ -479,12 +517,28 @@ def _knot_caps(bound, reduce=np.minimum):
     return caps
 
 
+def _knots_last(values):
+    """
+    Return knot values (N, k, d) as the sweeps' contiguous (d, k, N) array.
+
+    Every row is one coordinate of one robot over all knots: adding a knot's
+    common part broadcasts over whole rows (with d last, each inner loop would
+    be d = 2 long), and the mean over the robots (axis 1) adds them one by one,
+    in the order it takes over (N, k, d), so the values are the same.
+    """
+    return np.ascontiguousarray(np.transpose(values, (2, 1, 0)))
+
+
 def _clipped(move, caps):
-    """Return the moves (..., d) scaled down to lengths <= caps (...); zero at cap 0."""
-    length = _length(move)
-    over = length > caps
-    scale = np.divide(caps, length, out=np.ones_like(length), where=over)
-    return move * scale[..., None]
+    """Return the moves (d, ...) scaled down to lengths <= caps (...), in place; 0 at cap 0."""
+    length = _planes_length(move)
+    # caps / length where a move is longer than its cap, else 1: the quotient rounds to
+    # >= 1 wherever length <= caps, and fmin takes 1 for the 0 / 0 of a zero move at cap 0
+    # (a masked division costs three times as much).
+    with np.errstate(divide='ignore', invalid='ignore'):
+        scale = np.divide(caps, length, out=length)
+    move *= np.fmin(scale, 1.0, out=scale)
+    return move
 
 
 class _Block:
@@ -497,7 +551,8 @@ class _Block:
     cap (0 where a pair has no slack, so rounding cannot take any); |own| <=
     the pair cap, <= what common leaves of the pillar cap and <= step. Both
     are totals over the block, so a robot's displacement at any instant of the
-    block stays within its caps (design, 14).
+    block stays within its caps (design, 14). Moves are in the sweeps' layout
+    (_knots_last): common (d, 1, N), own (d, k, N).
     """
 
     def __init__(self, caps, step):
@@ -507,27 +562,32 @@ class _Block:
         # smallest pair cap does that and stays continuous.
         self.common_cap = np.minimum(np.minimum(0.5 * caps.pillar.min(axis=1), step),
                                      _TRANSLATION * caps.pair.min(axis=1))
-        self.pair, self.pillar, self.step = caps.pair, caps.pillar, step
-        self.lower, self.upper = caps.lower, caps.upper
-        if self.lower is not None:
+        self.pair, self.pillar = caps.pair.T, caps.pillar.T
+        self.own_cap = np.minimum(self.pair, step)
+        self.lower = self.upper = None
+        if caps.lower is not None:
+            self.lower, self.upper = _knots_last(caps.lower), _knots_last(caps.upper)
             # The common part stays within every robot's range along each axis.
-            self.common_range = (-self.lower.min(axis=1), self.upper.min(axis=1))
+            self.common_range = (-self.lower.min(axis=1, keepdims=True),
+                                 self.upper.min(axis=1, keepdims=True))
 
     def clip(self, wanted):
         """
-        Return (common (N, d), own (N, k, d)): the wanted totals (N, k, d) within the caps.
+        Return (common (d, 1, N), own (d, k, N)): the wanted totals (d, k, N) within the caps.
 
-        common is the fleet's mean, clipped; own what each robot still wants, clipped.
+        common is the fleet's mean, clipped; own what each robot still wants,
+        clipped (wanted is overwritten).
         """
-        common = _clipped(wanted.mean(axis=1), self.common_cap)
+        # The mean: the sum over the robots divided by k, as np.mean takes it.
+        common = _clipped(np.add.reduce(wanted, axis=1, keepdims=True) / wanted.shape[1],
+                          self.common_cap)
         if self.lower is not None:
             # Within every robot's wall limits, so each robot's own part has room around 0.
             common = np.clip(common, *self.common_range)
-        left = self.pillar - _length(common)[:, None]
-        own = _clipped(wanted - common[:, None], np.minimum(np.minimum(self.pair, left),
-                                                            self.step))
+        left = self.pillar - _planes_length(common)
+        own = _clipped(np.subtract(wanted, common, out=wanted), np.minimum(self.own_cap, left))
         if self.lower is not None:
-            own = np.clip(own, -self.lower - common[:, None], self.upper - common[:, None])
+            own = np.clip(own, -self.lower - common, self.upper - common)
         return common, own
 
 
@@ -539,22 +599,23 @@ def _sweep(origin, common, own, block):
     split into the fleet's mean and each robot's own part; knots of one parity
     have no neighbour of the same parity, so each half sweep uses the other
     half's newest values. origin is where the block starts: the construction's
-    knots plus the field so far, in that order.
+    knots plus the field so far, in that order (all in the layout _knots_last).
     """
+    current = np.empty_like(origin)
     for parity in (1, 0):
-        current = origin + common[:, None]
+        np.add(origin, common, out=current)
         current += own
         # The knots of this parity (slices: views, not gathers) and their two neighbours.
         first = parity + (1 - parity) * 2
-        index = slice(first, current.shape[0] - 1, 2)
+        index = slice(first, current.shape[2] - 1, 2)
         before, after = slice(first - 1, -2, 2), slice(first + 1, None, 2)
         # RELAXATION x (the neighbours' midpoint - the knot), in place.
-        move = current[before] + current[after]
+        move = current[..., before] + current[..., after]
         move *= 0.5
-        move -= current[index]
+        move -= current[..., index]
         move *= RELAXATION
-        wanted = common[:, None] + own
-        wanted[index] += move
+        wanted = common + own
+        wanted[..., index] += move
         common, own = block.clip(wanted)
     return common, own
 
@@ -600,8 +661,9 @@ def refine(times: np.ndarray, positions: np.ndarray, waypoint_indices: np.ndarra
     bodies = Bodies(bodies.obstacles, bodies.radii, min(bodies.margin, gap), bodies.rounding,
                     bodies.bounds)
     scale = fleet_scale(configurations, bodies.obstacles)
-    base_knots = union.positions[knots.points]
-    values = np.zeros((knots.times.size, k, d))
+    base_knots = _knots_last(union.positions[knots.points])
+    # The field's values at the knots, in the sweeps' layout (d, k, N).
+    values = np.zeros_like(base_knots)
     motion = union.positions
     step = STEP * scale
     for block_index in range(blocks):
@@ -609,14 +671,14 @@ def refine(times: np.ndarray, positions: np.ndarray, waypoint_indices: np.ndarra
             nearest = _Nearest.of(motion, knots, bodies)
         caps = _Caps(nearest, knots, bodies, step)
         block = _Block(caps, step)
-        common, own = ((np.zeros((values.shape[0], d)), np.zeros_like(values))
-                       if caps.inward is None else block.clip(caps.inward))
+        common, own = ((np.zeros((d, 1, values.shape[2])), np.zeros_like(values))
+                       if caps.inward is None else block.clip(_knots_last(caps.inward)))
         origin = base_knots + values
         for _ in range(SWEEPS):
             common, own = _sweep(origin, common, own, block)
-        values = values + common[:, None] + own
+        values = values + common + own
         # x + 0.0 is x: a robot held everywhere in an interval keeps x's breakpoints.
-        motion = union.positions + knots.field(values)
+        motion = union.positions + knots.field(np.transpose(values, (2, 1, 0)))
     motion[union.waypoint_indices] = configurations
     return Refinement(union.times, motion, union.waypoint_indices, union.base_legs,
                       bodies.margin)
