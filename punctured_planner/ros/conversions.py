@@ -134,8 +134,9 @@ def to_xyz(points, plane_z=0.0):
     points = np.asarray(points, dtype=float)
     if points.shape[-1] == 3:
         return points
-    return np.concatenate([points, np.full(points.shape[:-1] + (1,), float(plane_z))],
-                          axis=-1)
+    xyz = np.empty(points.shape[:-1] + (3,))
+    xyz[..., :2], xyz[..., 2] = points, plane_z
+    return xyz
 
 
 def normalized_quaternions(quaternions):
@@ -284,7 +285,9 @@ def plan_to_paths(samples, orientations, frame_id, start_ns, plane_z=0.0):
             stamped = new(PoseStamped)
             stamped._header, stamped._pose, stamped._check_fields = pose_header, pose, False
             poses.append(stamped)
-        paths.append(_filled(Path, header=path_header, poses=poses))
+        path = new(Path)
+        path._header, path._poses, path._check_fields = path_header, poses, False
+        paths.append(path)
     return Paths(paths, frame_id, start_ns, stamps, xyz, quaternions, waypoint)
 
 
