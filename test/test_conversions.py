@@ -39,6 +39,11 @@ def test_message_arrays_round_trip():
     assert np.array_equal(positions, CONFIGURATIONS[1])
     assert np.array_equal(orientations, [YAW_90] * 4)
     assert [a.shape for a in conversions.pose_array_poses(pose_array([]))] == [(0, 3), (0, 4)]
+    # a request's configurations, one after the other in one array
+    positions, orientations = conversions.pose_arrays_poses(
+        [pose_array(CONFIGURATIONS[0]), pose_array([]), msg])
+    assert np.array_equal(positions, np.concatenate([CONFIGURATIONS[0], CONFIGURATIONS[1]]))
+    assert np.array_equal(orientations[len(CONFIGURATIONS[0]):], [YAW_90] * 4)
     assert conversions.pose_array_positions(pose_array([])).shape == (0, 3)
     assert conversions.obstacles_from_parameter([]).shape == (0, 3)
     assert np.array_equal(conversions.to_xyz(np.ones((2, 2)), 1.5), [[1, 1, 1.5]] * 2)

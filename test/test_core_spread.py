@@ -113,19 +113,23 @@ def test_required_clearance_refuses_with_pair_leg_and_distance():
     assert base(relaxed, request).min_clearance == pytest.approx(1 / 3)
 
 
-def test_fallback_isotonic_fit_equals_scipy():
-    """The pool-adjacent-violators fallback (SciPy < 1.12) gives SciPy's fit."""
+def test_python_isotonic_fit_is_scipys_bit_for_bit():
+    """pool_adjacent_violators (small blocks, SciPy < 1.12) gives SciPy's fit to the bit."""
     from scipy.optimize import isotonic_regression
     rng = np.random.default_rng(5)
-    for size in (1, 2, 3, 7, 40):
-        values = rng.normal(size=size).round(2)
-        assert np.allclose(pool_adjacent_violators(values), isotonic_regression(values).x)
+    for size in (1, 2, 3, 7, 40, 100):
+        for values in (rng.normal(size=size).round(2), rng.integers(0, 3, size) * 0.1,
+                       rng.normal(size=size) * 1e3 - np.arange(size) * 7.0):
+            fit = np.array(pool_adjacent_violators(values))
+            assert np.array_equal(fit.view(np.int64), isotonic_regression(values).x.view(np.int64))
 
 
 def test_spread_without_scipy_isotonic_regression(monkeypatch):
-    """With SciPy's isotonic regression missing, S uses the fallback and spreads the same."""
-    projections = np.array([[0.1, 0.11, 0.12, 2.2, 2.1001, 5.0]])
+    """With SciPy's isotonic regression missing, S uses the Python fit and spreads the same."""
+    rng = np.random.default_rng(2)
+    # 50 robots crowded into (0, 1): one block longer than those fitted in Python anyway
+    projections = np.concatenate([rng.uniform(0.1, 0.9, 50), [2.2, 2.1001, 5.0]])[None]
     expected, _ = spread(np.sort(projections), np.array([0.0, 1.0, 3.0]), 0.5)
     monkeypatch.setattr(deformations, 'isotonic_regression', None)
     fallback, _ = spread(np.sort(projections), np.array([0.0, 1.0, 3.0]), 0.5)
-    assert np.allclose(fallback, expected)
+    assert np.array_equal(fallback, expected)

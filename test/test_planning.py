@@ -42,7 +42,7 @@ def test_over_limit_requests_are_refused_before_conversion(monkeypatch):
     huge.poses = [Pose()] * 20001  # one shared Pose: cheap to build
     request.configurations = [huge, huge]
     converted = []
-    monkeypatch.setattr(conversions, 'pose_array_poses', converted.append)
+    monkeypatch.setattr(conversions, 'pose_arrays_poses', converted.append)
     outcome = PlanSequenceHandler().handle(request, PlanSequence.Response(), snapshot(), 0)
     assert outcome.response.error_code == PlanSequence.Response.REQUEST_OVER_LIMITS
     assert 'max_robots 10000' in outcome.response.error_msg

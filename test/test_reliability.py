@@ -506,7 +506,7 @@ def test_the_limit_check_runs_before_any_conversion(monkeypatch):
     def forbidden(*args, **kwargs):
         raise AssertionError('converted a request that is over the limits')
 
-    for name in ('pose_array_positions', 'pose_array_poses'):
+    for name in ('pose_array_positions', 'pose_array_poses', 'pose_arrays_poses'):
         monkeypatch.setattr(conversions, name, forbidden)
     monkeypatch.setattr(planning.np, 'stack', forbidden, raising=True)
     settings = PLANNER.settings(PARAMETERS)

@@ -17,28 +17,56 @@ except ImportError:  # SciPy < 1.12: Ubuntu 24.04's python3-scipy (ROS 2 Jazzy) 
     isotonic_regression = None
 
 
-def pool_adjacent_violators(values: np.ndarray) -> np.ndarray:
+# Blocks up to this long are fitted in Python: SciPy's call costs more than the whole fit
+# of a few values, and the spreading leg fits many small groups per request.
+_PYTHON_FIT_SIZE = 32
+
+
+def pool_adjacent_violators(values: list[float]) -> list[float]:
     """
     Return the non-decreasing least-squares fit of values (unit weights).
 
-    The classic pool-adjacent-violators pass; used only where SciPy lacks
-    scipy.optimize.isotonic_regression (before 1.12).
+    Busing's O(n) pool-adjacent-violators pass (J. Stat. Softw. 102, 2022) with
+    SciPy's choices: equal neighbours pool (>=) and every block keeps its
+    weighted sum, so the result is SciPy's isotonic_regression bit for bit.
     """
-    means, counts = [], []
-    for value in values:
-        means.append(float(value))
-        counts.append(1)
-        while len(means) > 1 and means[-2] > means[-1]:
-            mean, count = means.pop(), counts.pop()
-            means[-1] = (means[-1] * counts[-1] + mean * count) / (counts[-1] + count)
-            counts[-1] += count
-    return np.repeat(means, counts)
+    means = list(values)
+    size = len(means)
+    weights = [1.0] * size
+    ends = [0] * (size + 1)  # block b is means[ends[b]:ends[b + 1]]
+    ends[1] = 1
+    block, i = 0, 1
+    while i < size:
+        block += 1
+        mean, weight = means[i], 1.0
+        if means[block - 1] >= mean:
+            block -= 1
+            total = weights[block] * means[block] + mean
+            weight += weights[block]
+            mean = total / weight
+            while i + 1 < size and mean >= means[i + 1]:  # pool the values ahead
+                i += 1
+                total += means[i]
+                weight += 1.0
+                mean = total / weight
+            while block > 0 and means[block - 1] >= mean:  # pool the blocks behind
+                block -= 1
+                total += weights[block] * means[block]
+                weight += weights[block]
+                mean = total / weight
+        means[block], weights[block] = mean, weight
+        ends[block + 1] = i + 1
+        i += 1
+    fit = []
+    for b in range(block + 1):
+        fit.extend([means[b]] * (ends[b + 1] - ends[b]))
+    return fit
 
 
-def isotonic_fit(values: np.ndarray) -> np.ndarray:
-    """Return the non-decreasing least-squares fit of values: SciPy's, or the fallback."""
-    if isotonic_regression is None:
-        return pool_adjacent_violators(values)
+def isotonic_fit(values: np.ndarray) -> np.ndarray | list[float]:
+    """Return the non-decreasing least-squares fit of values: SciPy's, or the same in Python."""
+    if isotonic_regression is None or values.size <= _PYTHON_FIT_SIZE:
+        return pool_adjacent_violators(values.tolist())
     return isotonic_regression(values).x
 
 
@@ -53,12 +81,6 @@ def desingularizing_shift(projection_counts: np.ndarray, eps: np.ndarray, robot_
 def desingularize(configurations: np.ndarray, shift: np.ndarray, e1: np.ndarray) -> np.ndarray:
     """Return D(C, 1) = C + shift e1 for configurations (n, k, d) and shifts (n, k)."""
     return configurations + shift[..., None] * e1
-
-
-def _interval_spacing(lengths, counts, min_spacing):
-    """Return the spacing used in each interval: min_spacing, or evenly what fits."""
-    with np.errstate(divide='ignore', invalid='ignore'):
-        return np.minimum(min_spacing, lengths / (counts + 1))
 
 
 def spread(projections: np.ndarray, sorted_obstacle_projections: np.ndarray,
@@ -78,26 +100,30 @@ def spread(projections: np.ndarray, sorted_obstacle_projections: np.ndarray,
     Returns (spread projections (n, k), spacing used per robot (n, k)).
     """
     n, k = projections.shape
-    bounds = np.concatenate([[-np.inf], sorted_obstacle_projections, [np.inf]])
+    size = n * k
+    bounds = np.empty(sorted_obstacle_projections.size + 2)  # interval i: bounds[i:i + 2]
+    bounds[0], bounds[1:-1], bounds[-1] = -np.inf, sorted_obstacle_projections, np.inf
     interval = np.searchsorted(sorted_obstacle_projections, projections)
     # One group per (configuration, interval); robots sorted inside each group.
-    group = np.arange(n)[:, None] * bounds.size + interval
+    group = (np.arange(n)[:, None] * bounds.size + interval).ravel()
+    interval = interval.ravel()
     flat = projections.ravel()
-    order = np.lexsort((flat, group.ravel()))
-    group_sorted = group.ravel()[order]
-    size = group_sorted.size
+    order = np.lexsort((flat, group))
+    group_sorted = group[order]
     first = np.empty(size, dtype=bool)  # whether each sorted robot starts its group
     first[0] = True
     np.not_equal(group_sorted[1:], group_sorted[:-1], out=first[1:])
-    starts = np.flatnonzero(first)
-    member = np.cumsum(first) - 1  # the group of each sorted robot
-    sizes = np.diff(starts, append=size)
+    starts = first.nonzero()[0]
+    member = first.cumsum() - 1  # the group of each sorted robot
+    sizes = np.bincount(member)
     rank = np.arange(size) - starts[member]
     count = sizes[member]
-    interval_sorted = interval.ravel()[order]
+    interval_sorted = interval[order]
     low, high = bounds[interval_sorted], bounds[interval_sorted + 1]
-    spacing = _interval_spacing(high - low, count, min_spacing)
-    z = flat[order] - (rank + 1) * spacing
+    # Nothing to warn about: count >= 1, and a length is positive or inf (no obstacles).
+    spacing = np.minimum(min_spacing, (high - low) / (count + 1))
+    offset = (rank + 1) * spacing
+    z = flat[order] - offset
     # Only groups whose shifted positions are out of order need a fit: an
     # ordered z is its own isotonic regression (up to the rounding of pooled
     # ties). A descent across two groups marks the first of them.
@@ -106,9 +132,10 @@ def spread(projections: np.ndarray, sorted_obstacle_projections: np.ndarray,
     for start, block_size in zip(starts[disordered].tolist(), sizes[disordered].tolist()):
         block = slice(start, start + block_size)
         z[block] = isotonic_fit(z[block])
-    z = np.clip(z, low, high - (count + 1) * spacing)
-    result = np.empty(n * k)
-    result[order] = z + (rank + 1) * spacing
-    used = np.empty(n * k)
+    # np.clip's own rule (the upper bound wins where the bounds cross), without its wrapper
+    z = np.minimum(np.maximum(z, low), high - (count + 1) * spacing)
+    result = np.empty(size)
+    result[order] = z + offset
+    used = np.empty(size)
     used[order] = spacing
     return result.reshape(n, k), used.reshape(n, k)

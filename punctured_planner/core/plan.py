@@ -281,8 +281,8 @@ class Plan:
         values = (self.times if max_speed is None
                   else self.stamps(max_speed, max_acceleration))
         new = np.ones(values.size, dtype=bool)
-        new[1:] = (values[1:] != values[:-1]) | np.any(
-            self.positions[1:] != self.positions[:-1], axis=(1, 2))
+        new[1:] = (values[1:] != values[:-1]) | (
+            self.positions[1:] != self.positions[:-1]).any(axis=(1, 2))
         # resample uses the profile only to stamp samples inside the legs: with none,
         # every stamp is a breakpoint's own.
         profile = (self.profile(max_speed, max_acceleration, self.positions[new])
@@ -290,7 +290,7 @@ class Plan:
                    else None)
         values, positions, _ = resample(values[new], self.positions[new], samples_per_leg,
                                         profile)
-        kept = np.cumsum(new) - 1
+        kept = new.cumsum() - 1
         step = max(int(samples_per_leg), 0) + 1
         return Samples(values, positions, kept[self.waypoint_indices] * step)
 
@@ -337,12 +337,13 @@ def _axis_plan(workspace, configurations, projections, gaps, counts):
     desingularized = desingularize(configurations, shift, frame.e1)
     projections = projections + shift
     stages = [configurations, desingularized]
-    spacing = np.full((n, k), np.inf)
     if workspace.variant == 'spread':
         spread_projections, spacing = spread(projections, workspace.sorted_obstacle_projections,
                                              workspace.min_spacing)
         stages.append(desingularized + (spread_projections - projections)[..., None] * frame.e1)
         projections = spread_projections
+    else:
+        spacing = np.full((n, k), np.inf)
     stages.append(frame.axis_points(projections))
     lanes = lane_heights(k, r, workspace.lane_spacing, workspace.lane_base, workspace.variant)
     return Plan.axis(workspace, configurations, compose(stages, lanes, frame.e2), counts, lanes,

@@ -44,10 +44,11 @@ SCHEDULES = {
 VARIANTS = (*SCHEDULES, 'discs')
 
 
+@lru_cache(maxsize=64)
 def lane_heights(robot_count: int, obstacle_count: int, lane_spacing: float, lane_base: float,
                  variant: str) -> np.ndarray:
     """
-    Return the (k,) e2 heights of the lanes above the axis.
+    Return the (k,) e2 heights of the lanes above the axis (read-only: cached, as every plan's).
 
     Paper: robot i (1-based) has paper index r + i and lane height
     (r + i) lane_spacing, exactly the paper's heights for lane_spacing 1 and
@@ -56,7 +57,9 @@ def lane_heights(robot_count: int, obstacle_count: int, lane_spacing: float, lan
     the highest obstacle e2 offset, so the slides never meet an obstacle.
     """
     first = obstacle_count + 1 if variant == 'paper' else 1
-    return lane_base + (first + np.arange(robot_count)) * lane_spacing
+    lanes = lane_base + (first + np.arange(robot_count)) * lane_spacing
+    lanes.flags.writeable = False
+    return lanes
 
 
 @lru_cache(maxsize=64)

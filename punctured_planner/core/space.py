@@ -150,9 +150,10 @@ class Workspace:
         """Return r, the number of obstacles."""
         return len(self.obstacles)
 
-    @property
+    @cached_property
     def has_bodies(self) -> bool:
         """Return whether robots or obstacles have a radius (then gaps, not distances, count)."""
+        # Cached: read several times by every plan, and the radii are fixed per workspace.
         return self.robot_radius > 0 or bool(np.any(self.obstacle_radii > 0))
 
     @cached_property

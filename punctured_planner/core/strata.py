@@ -36,7 +36,8 @@ def projection_count(gaps: np.ndarray) -> np.ndarray:
 
     gaps are the (..., k + r - 1) sorted projection gaps; the result is (...) ints.
     """
-    return 1 + np.count_nonzero(gaps > 0, axis=-1)
+    # (gaps > 0).sum is count_nonzero's own sum, without its Python wrapper
+    return 1 + (gaps > 0).sum(axis=-1, dtype=np.intp)
 
 
 def epsilon(gaps: np.ndarray, fallback: float) -> np.ndarray:
@@ -46,5 +47,5 @@ def epsilon(gaps: np.ndarray, fallback: float) -> np.ndarray:
     When every projection coincides (only possible for r <= 1) the set is empty;
     `fallback` / (k + r), a constant, keeps D continuous on that stratum.
     """
-    smallest = np.min(gaps, axis=1, where=gaps > 0, initial=np.inf)
+    smallest = np.minimum.reduce(gaps, axis=1, where=gaps > 0, initial=np.inf)
     return np.where(np.isfinite(smallest), smallest, fallback) / (gaps.shape[1] + 1)

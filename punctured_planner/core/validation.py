@@ -185,7 +185,7 @@ def _first_overlap(configurations, obstacles, robot_radius, obstacle_radii):
                     robots = (m, a, b, float(gaps[inside[0]]))
                     break
     on = None
-    if len(obstacles) and (robot_radius > 0 or np.any(obstacle_radii > 0)):
+    if len(obstacles) and (robot_radius > 0 or (obstacle_radii > 0).any()):
         reach = robot_radius + obstacle_radii
         for m, configuration in enumerate(configurations):
             distance = np.linalg.norm(configuration[:, None] - obstacles[None], axis=2)

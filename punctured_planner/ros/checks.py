@@ -10,7 +10,9 @@ planar mode the core never sees z. Each raises a PlanningError with its
 culprits as data; :mod:`punctured_planner.ros.wording` names them.
 """
 
+import bisect
 from dataclasses import dataclass
+import itertools
 import math
 from typing import Any
 
@@ -174,15 +176,18 @@ def check_duration(duration: float, max_speed: float, start_ns: int) -> None:
 def check(gathered: Gathered, snapshot: Snapshot) -> Checked:
     """Step 2: convert the poses; the range, count, finiteness, frame and plane checks."""
     settings, obstacles, state = snapshot.settings, snapshot.obstacles, gathered.state
-    states = [state] if state is not None else []
-    poses = [conversions.pose_array_poses(c) for c in gathered.configurations]
-    arrays = [s.positions for s in states] + [p[0] for p in poses]
-    _check_range(settings, arrays)
+    # Every configuration's poses in one (N, 3) and one (N, 4) array, the state's first.
+    positions, orientations = conversions.pose_arrays_poses(gathered.configurations)
+    if state is not None:
+        positions = np.concatenate([state.positions, positions])
+        orientations = np.concatenate([state.orientations, orientations])
+    _check_range(settings, positions, gathered.counts)
     check_obstacle_range(settings, obstacles)
     _check_counts(settings, gathered)
-    positions = np.stack(arrays)
-    orientations = np.stack([s.orientations for s in states] + [p[1] for p in poses])
-    frames = [s.frame_id for s in states] + [c.header.frame_id for c in gathered.configurations]
+    n = len(gathered.counts)  # each of them with counts[0] robots, as just checked
+    positions, orientations = positions.reshape(n, -1, 3), orientations.reshape(n, -1, 4)
+    frames = ([state.frame_id] if state is not None else []) + [
+        c.header.frame_id for c in gathered.configurations]
     _check_non_finite(positions)
     check_obstacle_values(obstacles)
     _check_frames(settings, frames)
@@ -198,24 +203,28 @@ def check(gathered: Gathered, snapshot: Snapshot) -> Checked:
     return Checked(positions, orientations, planned, dropped)
 
 
-def _check_range(settings: PlannerSettings, arrays: list[np.ndarray]) -> None:
+def _check_range(settings: PlannerSettings, points: np.ndarray, counts: list[int]) -> None:
     """
     INVALID_REQUEST for a finite coordinate beyond the core's range (+-1e15).
 
-    The core checks this too, but only after codes 5-8; here it keeps the
-    documented priority. Only the d coordinates the core plans in count (in
-    planar mode z has its own check, OFF_PLANE); non-finite values are
-    NON_FINITE_VALUE.
+    points (N, 3) are every configuration's robots in order, counts[m] of them
+    in configuration m. The core checks this too, but only after codes 5-8;
+    here it keeps the documented priority. Only the d coordinates the core
+    plans in count (in planar mode z has its own check, OFF_PLANE); non-finite
+    values are NON_FINITE_VALUE.
     """
-    for m, points in enumerate(arrays):
-        far = first_out_of_range(points[:, :settings.dimension])
-        if far is not None:
-            robot, axis = far
-            raise PlanningError(
-                ErrorCode.INVALID_REQUEST, '{configuration}, robot %d: %s = %.6g is beyond '
-                'the supported range +-%.0e' % (robot, _AXES[axis], float(points[far]),
-                                                MAX_COORDINATE),
-                configuration=m, robots=[robot], coordinate=axis)
+    far = first_out_of_range(points[:, :settings.dimension])
+    if far is None:
+        return
+    row, axis = far
+    ends = list(itertools.accumulate(counts))
+    m = bisect.bisect_right(ends, row)  # the first offender's configuration, then its robot
+    robot = row - (ends[m - 1] if m else 0)
+    raise PlanningError(
+        ErrorCode.INVALID_REQUEST, '{configuration}, robot %d: %s = %.6g is beyond '
+        'the supported range +-%.0e' % (robot, _AXES[axis], float(points[far]),
+                                        MAX_COORDINATE),
+        configuration=m, robots=[robot], coordinate=axis)
 
 
 def check_obstacle_range(settings: PlannerSettings, obstacles: ObstacleSet) -> None:

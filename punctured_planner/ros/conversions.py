@@ -62,17 +62,25 @@ def pose_array_positions(msg):
 
 
 def pose_array_poses(msg):
-    """
-    Return (positions (k, 3), orientations (k, 4): x, y, z, w) of a PoseArray, in one pass.
+    """Return (positions (k, 3), orientations (k, 4): x, y, z, w) of a PoseArray."""
+    return pose_arrays_poses([msg])
 
-    Every request's poses come through here: the fields are read from their slots
-    (``_x`` for x, as :func:`_filled` writes them), half the time of their properties.
+
+def pose_arrays_poses(messages):
+    """
+    Return (positions (N, 3), orientations (N, 4)) of the poses of PoseArrays, in their order.
+
+    Every request's poses come through here, all its configurations in one array
+    (one conversion, not one per configuration); the fields are read from their
+    slots (``_x`` for x, as :func:`_filled` writes them), half the time of their
+    properties.
     """
     rows = []
-    for p in msg.poses:
-        position, orientation = p._position, p._orientation
-        rows.append((position._x, position._y, position._z,
-                     orientation._x, orientation._y, orientation._z, orientation._w))
+    for msg in messages:
+        for p in msg.poses:
+            position, orientation = p._position, p._orientation
+            rows.append((position._x, position._y, position._z,
+                         orientation._x, orientation._y, orientation._z, orientation._w))
     values = np.array(rows, dtype=float).reshape(-1, 7)
     return values[:, :3], values[:, 3:]
 
@@ -126,15 +134,18 @@ def to_xyz(points, plane_z=0.0):
     points = np.asarray(points, dtype=float)
     if points.shape[-1] == 3:
         return points
-    return np.concatenate([points, np.full(points.shape[:-1] + (1,), float(plane_z))],
-                          axis=-1)
+    xyz = np.empty(points.shape[:-1] + (3,))
+    xyz[..., :2], xyz[..., 2] = points, plane_z
+    return xyz
 
 
 def normalized_quaternions(quaternions):
     """Return (..., 4) quaternions normalised; zero-length or non-finite ones -> identity."""
     quaternions = np.asarray(quaternions, dtype=float)
     with np.errstate(invalid='ignore', over='ignore'):
-        norms = np.linalg.norm(quaternions, axis=-1, keepdims=True)
+        # np.linalg.norm's own sum of squares, without its Python wrapper (a request's
+        # orientations are a few dozen values)
+        norms = np.sqrt(np.add.reduce(quaternions * quaternions, axis=-1, keepdims=True))
         good = np.isfinite(norms) & (norms > 0)
         result = np.where(good, quaternions / np.where(good, norms, 1.0), IDENTITY)
     return result
@@ -156,9 +167,15 @@ def time_from_ns(ns):
 
 
 def duration_from_seconds(seconds):
-    """Return builtin_interfaces/Duration for a finite number of seconds (rounded to ns)."""
-    ns = int(round(float(seconds) * 1e9))
-    return Duration(sec=ns // 1000000000, nanosec=ns % 1000000000)
+    """
+    Return builtin_interfaces/Duration for a finite number of seconds (rounded to ns).
+
+    Filled in place, as :func:`time_from_ns`: two of them in every response.
+    """
+    duration = object.__new__(Duration)
+    duration._sec, duration._nanosec = divmod(int(round(float(seconds) * 1e9)), 1000000000)
+    duration._check_fields = False
+    return duration
 
 
 # ---------------------------------------------------------------- arrays -> messages
@@ -209,15 +226,22 @@ class Paths(list):
     publishes after the reply (msg_docs/topics.md), so the reply does not wait for them.
     """
 
-    def __init__(self, paths, frame_id, start_ns, stamps, values):
-        """Keep the Paths and what their bytes are built from: stamps (M,), values (k, M, 7)."""
+    def __init__(self, paths, frame_id, start_ns, stamps, xyz, quaternions, held):
+        """
+        Keep the Paths and what their bytes are built from.
+
+        stamps (M,), xyz (k, M, 3) and quaternions (k, n, 4), of which pose i
+        holds quaternions[:, held[i]].
+        """
         super().__init__(paths)
-        self._cdr = (frame_id, start_ns, stamps, values)
+        self._cdr = (frame_id, start_ns, stamps, xyz, quaternions, held)
 
     @cached_property
     def serialized(self):
         """Return each Path as CDR bytes (:func:`~punctured_planner.ros.cdr.serialized_paths`)."""
-        return serialized_paths(*self._cdr)
+        frame_id, start_ns, stamps, xyz, quaternions, held = self._cdr
+        return serialized_paths(frame_id, start_ns, stamps,
+                                np.concatenate([xyz, quaternions[:, held]], axis=-1))
 
 
 def plan_to_paths(samples, orientations, frame_id, start_ns, plane_z=0.0):
@@ -261,9 +285,10 @@ def plan_to_paths(samples, orientations, frame_id, start_ns, plane_z=0.0):
             stamped = new(PoseStamped)
             stamped._header, stamped._pose, stamped._check_fields = pose_header, pose, False
             poses.append(stamped)
-        paths.append(_filled(Path, header=path_header, poses=poses))
-    return Paths(paths, frame_id, start_ns, stamps,
-                 np.concatenate([xyz, quaternions[:, waypoint]], axis=-1))
+        path = new(Path)
+        path._header, path._poses, path._check_fields = path_header, poses, False
+        paths.append(path)
+    return Paths(paths, frame_id, start_ns, stamps, xyz, quaternions, waypoint)
 
 
 def header(frame_id, stamp_ns):
