@@ -41,6 +41,11 @@ _PASS_ELEMENTS = 1 << 16
 # pairs, each run costs a pass of its own (with 16 legs, 40-robot plans keep 3 - 6% of
 # the pairs' runs refined, 8 - 11% unrefined).
 _RUN_LEGS = 16
+# Pair-legs (pairs x legs) from which the run filter pays for its boxes: measured on
+# point and disc plans, refined and not, it took 2-4x as long as evaluating every pair
+# below 10,000 (k = 8: 449 against 124 us on 145 breakpoints), broke even near 25,000
+# and saved a quarter at 36,000 (k = 20) and two thirds at 130,000 (k = 40).
+_RUN_FILTER_ENTRIES = 1 << 15
 # The pair filter's allowance for rounding, as a share of the coordinate and radius
 # scale: the closed form and the bounds each round to a few ulps of it, 1e5 times less.
 BOUND_SLACK = 1e-9
@@ -236,9 +241,10 @@ def _pruned_minima(planes, a, b, offsets):
     A smallest value: the smallest distance - offsets over every pair, for each
     offsets (pairs,) of the list; every pair that holds one, and every leg on
     which it does, is evaluated (_near_runs), so each such pair's
-    (distance, leg, fraction) is the same as over every leg.
+    (distance, leg, fraction) is the same as over every leg. Below
+    _RUN_FILTER_ENTRIES pair-legs every pair is evaluated on every leg: faster.
     """
-    if planes.shape[1] < 2:
+    if a.size * (planes.shape[1] - 1) < _RUN_FILTER_ENTRIES:
         return _per_pair_minima(planes, a, b)
     scale = _scale(planes) + max(float(np.abs(offset).max(initial=0.0)) for offset in offsets)
     return _per_pair_minima(planes, a, b, _near_runs(planes, a, b, offsets,
