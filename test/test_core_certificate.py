@@ -40,10 +40,31 @@ def test_pruned_certificate_equals_all_pairs(monkeypatch, seed, spread_out):
         p = plan(Workspace(obstacles, variant=variant), configurations, certify=False)
         pruned = certify(p.times, p.positions, obstacles)
         monkeypatch.setattr(certificate, '_DIRECT_ROBOTS', 10 ** 6)
+        monkeypatch.setattr(certificate, '_RUN_FILTER_ENTRIES', 10 ** 18)
         direct = certify(p.times, p.positions, obstacles)
         monkeypatch.undo()
         assert pruned.distance == direct.distance
         assert pruned.kind == direct.kind
+
+
+@pytest.mark.parametrize('lattice', [False, True])
+def test_the_run_filter_keeps_both_certificates_of_bodies(monkeypatch, lattice):
+    """Every pair on every leg, or only where the runs' boxes allow: the same Clearances."""
+    rng = np.random.default_rng(7)
+    k, v = 40, 120
+    if lattice:  # many exact ties: robots on a grid, moving in lockstep along rows
+        grid = np.stack(np.meshgrid(np.arange(8.0), np.arange(5.0)), -1).reshape(k, 2)
+        positions = grid + np.linspace(0.0, 3.0, v)[:, None, None] * [1.0, 0.0]
+    else:
+        positions = np.cumsum(rng.normal(0.0, 0.3, (v, k, 2)), axis=0)
+    obstacles = rng.uniform(-3, 8, (3, 2))
+    radii = np.concatenate([np.full(k, 0.2), [0.1, 0.3, 0.5]])
+    times = np.linspace(0.0, 1.0, v)
+    results = []
+    for entries in (0, 10 ** 18):
+        monkeypatch.setattr(certificate, '_RUN_FILTER_ENTRIES', entries)
+        results.append(certificate.certify_bodies(times, positions, obstacles, radii))
+    assert results[0] == results[1]
 
 
 def test_far_from_the_origin_tiny_gaps_are_refused_not_trusted():

@@ -6,6 +6,7 @@ robot's Path, the domain index and the markers out; every error code; parameter
 changes. The client is the ``ros_client`` fixture (another Context).
 """
 
+import gc
 import math
 import time
 
@@ -152,12 +153,14 @@ def test_every_error_code_and_the_node_keeps_serving(planner, ros_client, monkey
         for word in words:
             assert word in response.error_msg, response.error_msg
         assert len(response.paths) == 0 and response.domain_count == 0
+        assert gc.isenabled(), 'the collector is back on once the reply is out'
         seen.add(code)
         return response
 
     def valid():
         response = ros_client.call(client, make_request())
         assert response.error_code == codes.NONE, response.error_msg
+        assert gc.isenabled(), 'the collector is back on once the reply is out'
         return response
 
     def moved(configuration, robot, point):

@@ -140,6 +140,20 @@ def test_a_robot_standing_still_turns_to_its_next_move_without_holding_the_clock
     assert step.forward[1] == 0.0 and step.yaw_rates[1] > 0, 'robot 1 turns toward +y'
 
 
+def test_a_robot_off_its_moving_reference_follows_instead_of_turning_in_place():
+    """60 degrees off a moving reference: no turn in place, the clock runs, even at dt = 0."""
+    reference = Reference(np.array([0.0, 4.0]), np.array([[[0, 0, 0]], [[1, 1.7, 0]]], float),
+                          np.tile([0.0, 0.0, 0.0, 1.0], (2, 1, 1)))
+    execution = Execution(reference, 0.1, ExecutionSettings(
+        drive=('differential',), speed_limit=0.5, yaw_rate_limit=1.9))
+    for dt in (0.0, 0.05, 0.05):
+        step = execution.step(dt, reference.position(execution.plan_time), [False],
+                              quaternions([0.0]))
+        assert not execution.turning.any() and not execution.reverse.any()
+        assert step.forward[0] > 0 and step.yaw_rates[0] > 0, 'it drives and steers left'
+    assert step.rate > 0
+
+
 def test_drive_must_fit_the_robot_count():
     assert ExecutionSettings(drive=('differential',)).differential(3).tolist() == [True] * 3
     assert ExecutionSettings(drive=('holonomic', 'differential')).differential(2).tolist() \

@@ -46,8 +46,9 @@ _RUN_LEGS = 16
 # below 10,000 (k = 8: 449 against 124 us on 145 breakpoints), broke even near 25,000
 # and saved a quarter at 36,000 (k = 20) and two thirds at 130,000 (k = 40).
 _RUN_FILTER_ENTRIES = 1 << 15
-# The pair filter's allowance for rounding, as a share of the coordinate and radius
-# scale: the closed form and the bounds each round to a few ulps of it, 1e5 times less.
+# The pair filters' allowance for rounding (here and in refine.py), as a share of the
+# coordinate and radius scale: the closed form and the bounds each round to a few ulps
+# of it, 1e5 times less.
 BOUND_SLACK = 1e-9
 
 
@@ -190,8 +191,8 @@ def _near_runs(planes, a, b, offsets, slack):
     np.maximum(gap, 0.0, out=gap)
     lower = np.sqrt(_dot(gap, gap))
     lower -= slack
-    ends = _pair_differences(planes[:, np.append(firsts, v - 1)], a, b)
-    upper = np.sqrt(_dot(ends, ends))
+    at_starts = _pair_differences(planes[:, np.append(firsts, v - 1)], a, b)
+    upper = np.sqrt(_dot(at_starts, at_starts))
     kept = np.zeros(lower.shape, dtype=bool)
     for offset in offsets:
         kept |= lower - offset <= float((upper - offset).min())

@@ -32,6 +32,8 @@ def pool_adjacent_violators(values: list[float]) -> list[float]:
     """
     means = list(values)
     size = len(means)
+    if size == 0:
+        return []
     weights = [1.0] * size
     ends = [0] * (size + 1)  # block b is means[ends[b]:ends[b + 1]]
     ends[1] = 1

@@ -39,7 +39,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from .certificate import certify, evaluates_every_pair, segment_minimum
+from .certificate import BOUND_SLACK, certify, evaluates_every_pair, segment_minimum
 from .pairs import point_pairs
 from .walls import wall_slack
 
@@ -75,9 +75,6 @@ _TRANSLATION = 4.0
 # once: a few hundred kB stay in cache (with 1 << 21, megabytes per pass, the caps of a
 # 40-robot plan took about 1.5x as long).
 _ENTRIES = 1 << 15
-# The robot-pair filter's allowance for rounding, as a share of the coordinate scale: the
-# closed form and the bounds each round to a few ulps of it, 1e5 times less.
-_BOUND_SLACK = 1e-9
 # Coordinates up to this size are filtered; beyond, squares could overflow.
 _FILTERED_SCALE = 1e150
 # Entries (coordinate x knot x robot pair) of the filter's arrays computed at once.
@@ -367,12 +364,12 @@ def _interval_minima(planes, knots, pillars=None, offsets=None):
         batch = max(1, _FILTER_ENTRIES * len(runs) // (d * (points.size - 1) * max(width, 1)))
         for run in range(0, len(runs), batch):
             chosen = runs[run:run + batch]
-            margin = _BOUND_SLACK * scale
+            margin = BOUND_SLACK * scale
             near[run:run + batch] = (
                 _near_pairs(planes, points, chosen, a, b, margin, knots.partners)
                 if pillars is None else
                 _near_pillars(planes, points, chosen, pillars, offsets,
-                              margin + _BOUND_SLACK * float(np.abs(offsets).max())))
+                              margin + BOUND_SLACK * float(np.abs(offsets).max())))
     for run, (first, last) in enumerate(runs):
         piece = planes[:, points[first]:points[last] + 1]
         starts = points[first:last] - points[first]

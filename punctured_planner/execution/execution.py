@@ -402,10 +402,10 @@ class Execution:
         flip = self.differential & may_turn & (np.abs(alpha) > unicycle.REVERSE_ANGLE)
         self.reverse ^= flip
         alpha = np.where(flip, unicycle.wrap(alpha + np.pi), alpha)
-        waiting = still_until - self.plan_time >= dt
+        # still for the whole step; a reference moving now never waits, even for dt = 0
+        waiting = (still_until > self.plan_time) & (still_until - self.plan_time >= dt)
         self.turning = (self.differential & waiting & (self.turning | may_turn)
-                        & (np.abs(alpha) > unicycle.ALIGNED)
-                        & (self.plan_time < self.reference.duration))
+                        & (np.abs(alpha) > unicycle.ALIGNED))
         return alpha
 
     def _driving(self, angles: np.ndarray) -> np.ndarray:

@@ -127,6 +127,7 @@ class PlannerNode(Node):
         self._send = self._service.send_response
         self._service.send_response = self._send_response
         self._answering = 0  # the number of the request whose reply is being sent
+        self._collecting = True  # whether the cyclic collector ran when it was taken
         self._after_reply: AfterReply | None = None  # what to publish once it is sent
         s = self._settings
         self.get_logger().info(
@@ -221,12 +222,19 @@ class PlannerNode(Node):
         # sent (_send_response). A plan's messages are many objects (k x M poses), and a
         # full collection scanning them took 24-40 ms inside the reply of one call in
         # three at k = 512 (doc/design.md section 11); reference counting still frees.
+        # A host process that runs with the collector off keeps it off.
+        self._collecting = gc.isenabled()
         gc.disable()
         try:
             return self._plan_request(request, response)
         except BaseException:
-            gc.enable()
+            self._resume_collection()
             raise
+
+    def _resume_collection(self):
+        """Turn the cyclic collector back on if it was on when the call was taken."""
+        if self._collecting:
+            gc.enable()
 
     def _plan_request(self, request, response):
         """Plan one request against a snapshot; keep what to log and publish after the reply."""
@@ -277,11 +285,11 @@ class PlannerNode(Node):
         warnings.catch_warnings is process-wide: a warning of another thread in this
         short window is shown again below, not lost.
         """
-        number, sequence = self._answering, header.request_id.sequence_number
         try:
+            number, sequence = self._answering, header.request_id.sequence_number
             self._send_attempts(response, header, number, sequence)
         finally:
-            gc.enable()
+            self._resume_collection()
             after, self._after_reply = self._after_reply, None
             if after is not None:
                 self._log_outcome(after)
