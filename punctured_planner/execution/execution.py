@@ -392,8 +392,9 @@ class Execution:
         delta). So no robot is ever more than 90 degrees from where it goes,
         and it follows at the creep rate instead of turning in place with the
         fleet waiting. A robot whose reference stands still for the whole step
-        turns in place towards its next move (the centre stands, E grows by at
-        most 2e) until within ALIGNED of it: that costs the clock nothing.
+        and that is more than TURN_START off its next move turns in place towards
+        it (the centre stands, E grows by at most 2e) until within ALIGNED of it:
+        that costs the clock nothing.
         """
         s = self.settings
         directions, still_until = self.corners.upcoming(self.plan_time)
@@ -404,7 +405,8 @@ class Execution:
         alpha = np.where(flip, unicycle.wrap(alpha + np.pi), alpha)
         # still for the whole step; a reference moving now never waits, even for dt = 0
         waiting = (still_until > self.plan_time) & (still_until - self.plan_time >= dt)
-        self.turning = (self.differential & waiting & (self.turning | may_turn)
+        start = may_turn & (np.abs(alpha) > unicycle.TURN_START)
+        self.turning = (self.differential & waiting & (self.turning | start)
                         & (np.abs(alpha) > unicycle.ALIGNED))
         return alpha
 

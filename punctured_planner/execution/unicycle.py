@@ -44,6 +44,10 @@ STEERING = 0.1
 # the fleet at rest) took the 20-robot bench 1.73x the holonomic run, this 1.24x
 # (doc/design.md section 13).
 REVERSE_ANGLE = np.pi / 2
+# A robot whose reference stands still turns in place towards its next move when more
+# than this (rad) off it, and ends the turn within ALIGNED: the gap between the two keeps
+# it from switching between following and turning while it waits.
+TURN_START = np.pi / 4
 # A turn in place (while the reference stands still) ends this close (rad) to its heading.
 ALIGNED = 0.1
 # Fraction of the yaw-rate limit the clock leaves the lead point's sideways motion.
