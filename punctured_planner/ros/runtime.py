@@ -54,7 +54,8 @@ threads leave their loop after the callback in flight, and the group's
 goals; (2) what is in flight finishes: the plan call in flight writes its
 reply, each thread answers the service requests that had already arrived,
 and the hook ends the goal in flight while its thread spins on until the
-Future it returned is done (the result sent), at most ``STOP_DRAIN_SEC``;
+Future it returned is done (the result sent), at most ``STOP_DRAIN_SEC``, and
+``REPLY_GRACE_SEC`` more for a result request still on the wire;
 (3) the participant stays until ``REPLY_GRACE_SEC`` after the last reply
 written (a service's response or an action server's), so that the DDS writer
 can still deliver or resend it to a client that only just matched; (4)
@@ -276,7 +277,13 @@ class ExecutorThreads:
                 self._last_reply = time.monotonic()
 
     def _drain(self, executor: SingleThreadedExecutor, ended: Optional[Future]) -> None:
-        """Spin on until ``ended`` is done or STOP_DRAIN_SEC passed; a reply went out then."""
+        """
+        Spin on until ``ended`` is done (at most STOP_DRAIN_SEC), then REPLY_GRACE_SEC more.
+
+        The grace spin answers a request about what just ended that was still on
+        the wire when it ended: a client that asked for a goal's result just
+        before the stop gets it (``before_stop`` has made the node refuse new work).
+        """
         if ended is None:
             return
         deadline = time.monotonic() + STOP_DRAIN_SEC
@@ -289,6 +296,9 @@ class ExecutorThreads:
         while time.monotonic() < deadline and self._run_one(executor, _never, 0.0):
             pass
         self._last_reply = time.monotonic()
+        grace_end = self._last_reply + REPLY_GRACE_SEC
+        while (remaining := grace_end - time.monotonic()) > 0.0:
+            self._run_one(executor, _never, remaining)
 
     def stop(self, timeout_sec: float = STOP_TIMEOUT_SEC) -> bool:
         """
