@@ -7,9 +7,9 @@ corners at full speed, and the late robot, 0.1 m off its reference in its latenc
 alone, left the tolerance of 0.2 m on a loaded machine: 0.205 m). One run checks the
 refusals (no plan, a robot not heard, odometry in another frame), a goal that waits
 for its plan, a full execution with a stale robot in the middle (the clock holds,
-then resumes), the true gap, the arrival, a cancel, and Ctrl-C of the executor in the middle of a goal (the
-goal ends STOPPED, exit 0, no traceback, robots stopped, the simulator serving
-on). A second graph runs the same scene with differential-drive robots: only
+then resumes), the true gap, the arrival, a cancel, and Ctrl-C of the executor in
+the middle of a goal (the goal ends STOPPED, exit 0, no traceback, robots stopped,
+the simulator serving on). A second graph runs the same scene with differential-drive robots: only
 linear.x and angular.z commanded, the centres within the tolerance, each robot
 ending on its goal facing the requested heading. The figures for 20 robots are
 in bench/.
