@@ -17,6 +17,7 @@ pair is not evaluated there (_near_runs).
 """
 
 from dataclasses import dataclass
+from dataclasses import replace
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -73,6 +74,37 @@ class Clearance:
     resolution: float = 0.0
 
 
+@dataclass(frozen=True)
+class _Closest:
+    """The smallest value found (a distance or a surface gap), its pair and where it is."""
+
+    value: float
+    leg: int
+    first: int     # a robot
+    second: int    # a robot, or obstacle second - k
+    fraction: float
+
+
+_NOT_FOUND = _Closest(np.inf, 0, 0, 0, 0.0)
+
+
+@dataclass(frozen=True)
+class _PairMinima:
+    """Each pair's smallest distance over the legs (pairs,), its leg and its fraction."""
+
+    distance: np.ndarray
+    leg: np.ndarray
+    fraction: np.ndarray
+
+
+@dataclass(frozen=True)
+class _Runs:
+    """Runs of _RUN_LEGS legs and the pairs evaluated in each (_near_runs)."""
+
+    firsts: np.ndarray   # (R,) each run's first leg
+    kept: np.ndarray     # (R, pairs) bool
+
+
 def _dot(a, b):
     """Return the coordinate-wise dot product of coordinate-first arrays (d, ...)."""
     total = a[0] * b[0]
@@ -104,9 +136,9 @@ def segment_minimum(start: np.ndarray, velocity: np.ndarray) -> tuple[np.ndarray
     return _dot(closest, closest), t
 
 
-def _argmin_over_legs(start, end, legs, offsets=None):
+def _argmin_over_legs(start, end, legs, a, b, offsets=None):
     """
-    Return (value, leg, pair, fraction) of the smallest segment minimum.
+    Return the _Closest of the pairs (a[i], b[i]) over legs: the smallest segment minimum.
 
     start and end are (d, legs, pairs). value is the distance, or with offsets
     (pairs,) the distance minus the pair's offset (a surface gap): then each
@@ -116,23 +148,23 @@ def _argmin_over_legs(start, end, legs, offsets=None):
     if offsets is None:
         squared, fractions = segment_minimum(start, end - start)
         leg, pair = divmod(int(np.argmin(squared)), squared.shape[1])
-        return (float(np.sqrt(squared[leg, pair])), int(legs[leg]), int(pair),
-                float(fractions[leg, pair]))
+        return _Closest(float(np.sqrt(squared[leg, pair])), int(legs[leg]), int(a[pair]),
+                        int(b[pair]), float(fractions[leg, pair]))
     relative = np.concatenate([start, end[:, -1:]], axis=1)
-    distance, leg, fraction = _per_pair_minima(relative, np.arange(relative.shape[2]))
-    return _smallest(distance, leg, fraction, legs, offsets)
+    return _smallest(_per_pair_minima(relative, np.arange(relative.shape[2])), legs, offsets,
+                     a, b)
 
 
 def _per_pair_minima(planes, a, b=None, runs=None):
     """
-    Return each pair's (distance, leg, fraction) of its smallest distance over the legs.
+    Return each pair's _PairMinima: its smallest distance over the legs, and where.
 
     planes is (d, V, N): points at the breakpoints, coordinate first; the pairs
     are (a[i], b[i]), or with b None the points themselves are the pairs'
     relative positions (a selects them). The legs are taken a cache-sized pass
     at a time (_PASS_ELEMENTS), each pass gathering its own pairs; with runs
-    (_near_runs: first legs, pairs kept) a pass is one run and takes only the
-    pairs kept there (a pair kept in no run keeps distance inf).
+    (_Runs of _near_runs) a pass is one run and takes only the pairs kept there
+    (a pair kept in no run keeps distance inf).
     """
     d, v, _ = planes.shape
     count = a.size
@@ -144,9 +176,9 @@ def _per_pair_minima(planes, a, b=None, runs=None):
         step = max(1, _PASS_ELEMENTS // max(1, d * count))
         passes = [(first, slice(None)) for first in range(0, v - 1, step)]
     else:
-        firsts, near = runs
         step = _RUN_LEGS
-        passes = [(int(first), np.flatnonzero(kept)) for first, kept in zip(firsts, near)]
+        passes = [(int(first), np.flatnonzero(kept))
+                  for first, kept in zip(runs.firsts, runs.kept)]
     for first, pairs in passes:
         chosen = a[pairs]
         if chosen.size == 0:
@@ -166,12 +198,12 @@ def _per_pair_minima(planes, a, b=None, runs=None):
         best[improved] = value[better]
         leg[improved] = first + pass_leg[better]
         fraction[improved] = fractions[pass_leg, columns][better]
-    return np.sqrt(best), leg, fraction
+    return _PairMinima(np.sqrt(best), leg, fraction)
 
 
 def _near_runs(planes, a, b, offsets, slack):
     """
-    Return (first legs (R,), kept (R, pairs)): runs of _RUN_LEGS legs, pairs that matter there.
+    Return the _Runs: runs of _RUN_LEGS legs, and the pairs that matter in each.
 
     For each offsets (pairs,) of the list the smallest value is the smallest
     distance - offsets over every pair and leg; a run's first breakpoint (and
@@ -196,14 +228,15 @@ def _near_runs(planes, a, b, offsets, slack):
     kept = np.zeros(lower.shape, dtype=bool)
     for offset in offsets:
         kept |= lower - offset <= float((upper - offset).min())
-    return firsts, kept
+    return _Runs(firsts, kept)
 
 
-def _smallest(distance, leg, fraction, legs, offsets):
-    """Return (value, leg, pair, fraction) of the pair whose distance - offset is smallest."""
-    values = distance - offsets
+def _smallest(minima, legs, offsets, a, b):
+    """Return the _Closest of the pair (a[i], b[i]) whose distance - offset is smallest."""
+    values = minima.distance - offsets
     pair = int(np.argmin(values))
-    return float(values[pair]), int(legs[leg[pair]]), pair, float(fraction[pair])
+    return _Closest(float(values[pair]), int(legs[minima.leg[pair]]), int(a[pair]), int(b[pair]),
+                    float(minima.fraction[pair]))
 
 
 def _coordinate_first(points):
@@ -222,16 +255,16 @@ def _pair_differences(planes, a, b):
 
 
 def _pairs_minimum(points, legs, a, b, offsets=None):
-    """Return (value, leg, pair, fraction) of the closest pair (a[i], b[i]) over legs."""
-    best = (np.inf, 0, 0, 0.0)
+    """Return the _Closest of the pairs (a[i], b[i]) over legs."""
+    best = _NOT_FOUND
     planes = _coordinate_first(points)
     step = max(1, _CHUNK_ELEMENTS // max(1, a.size * points.shape[2]))
     for first in range(0, legs.size, step):
         chunk = legs[first:first + step]
         start = _pair_differences(planes[:, chunk], a, b)
         end = _pair_differences(planes[:, chunk + 1], a, b)
-        best = min(best, _argmin_over_legs(start, end, chunk, offsets),
-                   key=lambda item: item[0])
+        best = min(best, _argmin_over_legs(start, end, chunk, a, b, offsets),
+                   key=_value)
     return best
 
 
@@ -253,12 +286,17 @@ def _pruned_minima(planes, a, b, offsets):
 
 
 def _direct_minimum(points, robot_count, obstacle_count, offsets=None):
-    """Return (value, leg, pair, fraction) over every pair and every leg."""
+    """Return the _Closest over every pair and every leg."""
     a, b = point_pairs(robot_count, obstacle_count)
-    distance, leg, fraction = _pruned_minima(
+    minima = _pruned_minima(
         _coordinate_first(points), a, b, [np.zeros(a.size) if offsets is None else offsets])
-    return _smallest(distance, leg, fraction, np.arange(points.shape[0] - 1),
-                     0.0 if offsets is None else offsets)
+    return _smallest(minima, np.arange(points.shape[0] - 1), 0.0 if offsets is None else offsets,
+                     a, b)
+
+
+def _value(found):
+    """Return a _Closest's value: the key of min() over them (the first of equals wins)."""
+    return found.value
 
 
 def _breakpoint_bound(positions, obstacles):
@@ -302,18 +340,17 @@ def _sweep_pairs(start, end, bound):
 
 
 def _pruned_robot_minimum(positions, legs, bound):
-    """Return (distance, leg, a, b, fraction) of the closest robot pair, pruning by sweep."""
-    best = (np.inf, 0, 0, 0, 0.0)
+    """Return the _Closest robot pair (its distance), pruning by sweep."""
+    best = _NOT_FOUND
     for leg in legs:
         a, b = _sweep_pairs(positions[leg], positions[leg + 1], bound)
         if a.size == 0:
             continue
         # Only the leg's two breakpoints: the whole motion made contiguous per leg costs
         # O(V) each, O(V^2) in all.
-        distance, _, pair, fraction = _pairs_minimum(positions[leg:leg + 2], np.array([0]),
-                                                     a, b)
-        if distance < best[0]:
-            best = (distance, int(leg), int(a[pair]), int(b[pair]), fraction)
+        found = _pairs_minimum(positions[leg:leg + 2], np.array([0]), a, b)
+        if found.value < best.value:
+            best = replace(found, leg=int(leg))
     return best
 
 
@@ -325,7 +362,7 @@ def _moving_legs(positions):
 
 def _closest(points, k, radii=None):
     """
-    Return (value, leg, first, second, fraction); second >= k names obstacle second - k.
+    Return the _Closest pair of points; second >= k names obstacle second - k.
 
     points is (V, k + r, d): the robots at every breakpoint, then the obstacles.
     value is the smallest distance or, with radii (k + r,) of the points, the
@@ -338,23 +375,21 @@ def _closest(points, k, radii=None):
     offsets = None if radii is None else radii[a] + radii[b]
     if k <= _DIRECT_ROBOTS:
         if a.size * v * d <= _CHUNK_ELEMENTS:
-            value, leg, pair, fraction = _direct_minimum(points, k, r, offsets)
-        else:
-            value, leg, pair, fraction = _pairs_minimum(points, np.arange(v - 1), a, b, offsets)
-        return value, leg, int(a[pair]), int(b[pair]), fraction
+            return _direct_minimum(points, k, r, offsets)
+        return _pairs_minimum(points, np.arange(v - 1), a, b, offsets)
     # Many robots: every robot-obstacle pair, and the robot pairs the sweep keeps. All
     # robot pairs have one offset (2R), so the closest robot pair has the smallest gap.
     legs = _moving_legs(positions)
-    best = (np.inf, 0, 0, 0, 0.0)
+    best = _NOT_FOUND
     if r:
         a, b = a[a.size - k * r:], b[b.size - k * r:]
-        value, leg, pair, fraction = _pairs_minimum(
+        best = _pairs_minimum(
             points, legs, a, b, None if offsets is None else offsets[offsets.size - k * r:])
-        best = (value, leg, int(a[pair]), int(b[pair]), fraction)
     bound = _breakpoint_bound(positions, obstacles if radii is None else obstacles[:0])
-    distance, leg, first, second, fraction = _pruned_robot_minimum(positions, legs, bound)
-    found = (distance - (0.0 if radii is None else 2 * radii[0]), leg, first, second, fraction)
-    return min(best, found, key=lambda item: item[0])
+    found = _pruned_robot_minimum(positions, legs, bound)
+    if radii is not None:
+        found = replace(found, value=found.value - 2 * radii[0])
+    return min(best, found, key=_value)
 
 
 def _scale(points):
@@ -380,9 +415,9 @@ def _scaled(positions, obstacles, radii):
 
 
 def _clearance(found, times, k, exponent, resolution):
-    """Return the Clearance of a (value, leg, first, second, fraction) found by _closest."""
-    value, leg, first, second, fraction = found
-    value = float(np.ldexp(value, exponent))
+    """Return the Clearance of a _Closest found by _closest."""
+    leg, first, second, fraction = found.leg, found.first, found.second, found.fraction
+    value = float(np.ldexp(found.value, exponent))
     tau = float(times[leg] + fraction * (times[leg + 1] - times[leg]))
     if second >= k:
         return Clearance(value, 'obstacle', (first, second - k), leg, fraction, tau,
@@ -453,12 +488,8 @@ def certify_bodies(times: np.ndarray, positions: np.ndarray, obstacles: np.ndarr
                 _clearance(_closest(points, k, radii), times, k, exponent, resolution))
     planes = _coordinate_first(points)
     both = [np.zeros(a.size), radii[a] + radii[b]]
-    distance, per_pair_leg, per_pair_fraction = _pruned_minima(planes, a, b, both)
+    minima = _pruned_minima(planes, a, b, both)
     legs = np.arange(v - 1)
-    found = []
-    for offsets in both:
-        value, leg, pair, fraction = _smallest(distance, per_pair_leg, per_pair_fraction, legs,
-                                               offsets)
-        found.append(_clearance((value, leg, int(a[pair]), int(b[pair]), fraction), times, k,
-                                exponent, resolution))
-    return found[0], found[1]
+    centres, surfaces = (_clearance(_smallest(minima, legs, offsets, a, b), times, k, exponent,
+                                    resolution) for offsets in both)
+    return centres, surfaces

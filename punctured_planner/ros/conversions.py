@@ -26,6 +26,7 @@ Conventions:
   as the identity; others are normalised.
 """
 
+from dataclasses import dataclass
 from functools import cached_property
 
 from builtin_interfaces.msg import Duration
@@ -218,6 +219,18 @@ def _filled(message_type, **fields):
     return message
 
 
+@dataclass(frozen=True)
+class PathValues:
+    """The values of a plan's Paths as arrays: what their CDR bytes are built from."""
+
+    frame_id: str
+    start_ns: int            # the stamp of the first pose
+    stamps: np.ndarray       # (M,) ns, one per pose
+    xyz: np.ndarray          # (k, M, 3) positions
+    quaternions: np.ndarray  # (k, n, 4) orientations at the waypoints
+    held: np.ndarray         # (M,) pose i holds quaternions[:, held[i]]
+
+
 class Paths(list):
     """
     The robots' nav_msgs/Paths, and ``serialized``: the same Paths as CDR bytes (topics).
@@ -226,22 +239,18 @@ class Paths(list):
     publishes after the reply (msg_docs/topics.md), so the reply does not wait for them.
     """
 
-    def __init__(self, paths, frame_id, start_ns, stamps, xyz, quaternions, held):
-        """
-        Keep the Paths and what their bytes are built from.
-
-        stamps (M,), xyz (k, M, 3) and quaternions (k, n, 4), of which pose i
-        holds quaternions[:, held[i]].
-        """
+    def __init__(self, paths, values: PathValues):
+        """Keep the Paths and the values their bytes are built from."""
         super().__init__(paths)
-        self._cdr = (frame_id, start_ns, stamps, xyz, quaternions, held)
+        self.values = values
 
     @cached_property
     def serialized(self):
         """Return each Path as CDR bytes (:func:`~punctured_planner.ros.cdr.serialized_paths`)."""
-        frame_id, start_ns, stamps, xyz, quaternions, held = self._cdr
-        return serialized_paths(frame_id, start_ns, stamps,
-                                np.concatenate([xyz, quaternions[:, held]], axis=-1))
+        values = self.values
+        return serialized_paths(values.frame_id, values.start_ns, values.stamps,
+                                np.concatenate([values.xyz, values.quaternions[:, values.held]],
+                                               axis=-1))
 
 
 def plan_to_paths(samples, orientations, frame_id, start_ns, plane_z=0.0):
@@ -288,7 +297,7 @@ def plan_to_paths(samples, orientations, frame_id, start_ns, plane_z=0.0):
         path = new(Path)
         path._header, path._poses, path._check_fields = path_header, poses, False
         paths.append(path)
-    return Paths(paths, frame_id, start_ns, stamps, xyz, quaternions, waypoint)
+    return Paths(paths, PathValues(frame_id, start_ns, stamps, xyz, quaternions, waypoint))
 
 
 def header(frame_id, stamp_ns):
