@@ -263,9 +263,13 @@ def profile_text(call, repeats, lines=14, sort='tottime', restrict=None):
     out = io.StringIO()
     stats = pstats.Stats(profiler, stream=out).sort_stats(sort)
     stats.print_stats(*([restrict] if restrict else []), lines)
-    # Paths relative to the checkout: the figures name no machine's folders.
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__))) + os.sep
-    text = out.getvalue().replace(root, '')
+    # Paths relative to the checkout, the environment's folder and Python's own prefix
+    # (a venv outside the checkout, the interpreter's standard library): the figures
+    # name no machine's folders.
+    text = out.getvalue()
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    for folder in (root, os.path.dirname(sys.prefix), sys.base_prefix):
+        text = text.replace(folder + os.sep, '')
     return text[text.find('ncalls'):].rstrip()
 
 
