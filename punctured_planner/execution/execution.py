@@ -75,7 +75,7 @@ class ExecutionSettings:
     yaw_rate_limit: float = 1.0         # rad/s, differential robots
     final_heading: bool = True          # differential robots end facing their last pose
     # 1/s: how fast each robot's feed-forward gain learns its lag along its reference; 0: off
-    feedforward_adaptation: float = 1.0
+    feedforward_adaptation: float = 3.0
     # each robot's own speed (m/s) and acceleration (m/s^2) limits: one value, or one per
     # robot in plan order; empty: the plan's. The clock's reference is timed for them.
     max_speeds: tuple = ()

@@ -273,7 +273,7 @@ class ExecutorSettings:
         "orientation of its last pose (the request's; identity faces +x); 'none': it "
         'stops facing where it arrived.', choices=('request', 'none')).field()
     feedforward_adaptation: float = Spec(
-        'feedforward_adaptation', 'double', 1.0,
+        'feedforward_adaptation', 'double', 3.0,
         "How fast (1/s) each robot's feed-forward gain grows while it lags behind its "
         'moving reference by more than slow_fraction of the tolerance (and falls back '
         'toward 1 while it is ahead), up to 4: a robot that achieves a fraction f of its '
