@@ -127,6 +127,7 @@ bench: setup
 	@$(PIP_INSTALL) -r bench/requirements.txt -c constraints.txt 2>&1 | $(PIP_FILTER)
 	$(VPY) bench/run_all.py $(BENCH_ARGS)
 	$(VPY) bench/execution.py $(BENCH_ARGS)
+	$(VPY) bench/feedforward.py
 
 # A simulated fleet, the planner and the executor: plan, execute, record (about a minute).
 # DRIVE=differential: four TurtleBot 4-like differential robots (config/demo_differential*).

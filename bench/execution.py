@@ -75,8 +75,12 @@ def xyz(points):
 
 # ---------------------------------------------------------------- part 1: no DDS
 
-def simulate(the_plan, slow, late, shared_clock):
-    """Run Execution at 20 Hz against a Fleet at 40 Hz; return a dict of figures."""
+def simulate(the_plan, slow, late, shared_clock, **settings):
+    """
+    Run Execution at 20 Hz against a Fleet at 40 Hz; return a dict of figures.
+
+    settings are further ExecutionSettings fields (bench/feedforward.py's values).
+    """
     from punctured_planner.execution import Bodies
     from punctured_planner.execution import Execution
     from punctured_planner.execution import ExecutionSettings
@@ -95,7 +99,7 @@ def simulate(the_plan, slow, late, shared_clock):
         latencies=np.where(np.arange(K) == late, LATENCY, 0.0), velocity_noise=NOISE,
         seed=slow, max_acceleration=ACCELERATION))
     execution = Execution(reference, tolerance, ExecutionSettings(
-        speed_limit=SPEED, shared_clock=shared_clock), bodies)
+        speed_limit=SPEED, shared_clock=shared_clock, **settings), bodies)
     now, contacts = 0.0, 0
     while now < 10 * reference.duration:
         step = execution.step(0.05, fleet.positions, np.zeros(K, dtype=bool))

@@ -18,6 +18,7 @@ pair is not evaluated there (_near_runs).
 
 from dataclasses import dataclass
 from dataclasses import replace
+from operator import attrgetter
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -86,6 +87,8 @@ class _Closest:
 
 
 _NOT_FOUND = _Closest(np.inf, 0, 0, 0, 0.0)
+# The key of min() over _Closest values (the first of equals wins).
+_BY_VALUE = attrgetter('value')
 
 
 @dataclass(frozen=True)
@@ -264,7 +267,7 @@ def _pairs_minimum(points, legs, a, b, offsets=None):
         start = _pair_differences(planes[:, chunk], a, b)
         end = _pair_differences(planes[:, chunk + 1], a, b)
         best = min(best, _argmin_over_legs(start, end, chunk, a, b, offsets),
-                   key=_value)
+                   key=_BY_VALUE)
     return best
 
 
@@ -292,11 +295,6 @@ def _direct_minimum(points, robot_count, obstacle_count, offsets=None):
         _coordinate_first(points), a, b, [np.zeros(a.size) if offsets is None else offsets])
     return _smallest(minima, np.arange(points.shape[0] - 1), 0.0 if offsets is None else offsets,
                      a, b)
-
-
-def _value(found):
-    """Return a _Closest's value: the key of min() over them (the first of equals wins)."""
-    return found.value
 
 
 def _breakpoint_bound(positions, obstacles):
@@ -389,7 +387,7 @@ def _closest(points, k, radii=None):
     found = _pruned_robot_minimum(positions, legs, bound)
     if radii is not None:
         found = replace(found, value=found.value - 2 * radii[0])
-    return min(best, found, key=_value)
+    return min(best, found, key=_BY_VALUE)
 
 
 def _scale(points):
@@ -416,13 +414,14 @@ def _scaled(positions, obstacles, radii):
 
 def _clearance(found, times, k, exponent, resolution):
     """Return the Clearance of a _Closest found by _closest."""
-    leg, first, second, fraction = found.leg, found.first, found.second, found.fraction
+    leg, fraction = found.leg, found.fraction
     value = float(np.ldexp(found.value, exponent))
     tau = float(times[leg] + fraction * (times[leg + 1] - times[leg]))
-    if second >= k:
-        return Clearance(value, 'obstacle', (first, second - k), leg, fraction, tau,
-                         resolution)
-    return Clearance(value, 'robots', (first, second), leg, fraction, tau, resolution)
+    if found.second >= k:
+        return Clearance(value, 'obstacle', (found.first, found.second - k), leg, fraction,
+                         tau, resolution)
+    return Clearance(value, 'robots', (found.first, found.second), leg, fraction, tau,
+                     resolution)
 
 
 def _nothing(positions, obstacles, resolution):
