@@ -128,6 +128,7 @@ bench: setup
 	$(VPY) bench/run_all.py $(BENCH_ARGS)
 	$(VPY) bench/execution.py $(BENCH_ARGS)
 	$(VPY) bench/feedforward.py
+	$(VPY) bench/topology.py
 
 # A simulated fleet, the planner and the executor: plan, execute, record (about a minute).
 # DRIVE=differential: four TurtleBot 4-like differential robots (config/demo_differential*).
