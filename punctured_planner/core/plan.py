@@ -25,7 +25,7 @@ from .refine import block_count, Bodies, refine as refine_motion, Refinement
 from .sections import compose, lane_heights, SCHEDULES, segment_times
 from .space import Workspace
 from .strata import epsilon, projection_count, projection_gaps
-from .timing import (corner_jump, length_times, resample, speed_profile, SpeedProfile,
+from .timing import (corner_jump, leg_at, length_times, resample, speed_profile, SpeedProfile,
                      stamps as timed_stamps)
 from .validation import validate_configurations
 from .walls import check_plan_inside
@@ -225,7 +225,7 @@ class Plan:
     def position(self, tau: npt.ArrayLike) -> np.ndarray:
         """Return the robot positions at parameter(s) tau in [0, 1]: (k, d) or (..., k, d)."""
         tau = np.asarray(tau, dtype=float)
-        leg = np.clip(np.searchsorted(self.times, tau, side='right') - 1, 0, self.times.size - 2)
+        leg = leg_at(self.times, tau)
         start, end = self.times[leg], self.times[leg + 1]
         with np.errstate(divide='ignore', invalid='ignore'):
             fraction = np.where(end > start, (tau - start) / (end - start), 0.0)

@@ -41,6 +41,7 @@ import numpy as np
 
 from .certificate import BOUND_SLACK, certify, evaluates_every_pair, segment_minimum
 from .pairs import point_pairs
+from .timing import leg_at
 from .walls import wall_slack
 
 # Knots per segment: the field is piecewise linear on the j / KNOTS fractions.
@@ -138,7 +139,7 @@ def union_motion(times: np.ndarray, positions: np.ndarray,
                  waypoint_indices: np.ndarray, knots: np.ndarray) -> _Union:
     """Return x on the union of its breakpoints and the knots; waypoints kept bit for bit."""
     extra = knots[~np.isin(knots, times)]
-    leg = np.clip(np.searchsorted(times, extra, side='right') - 1, 0, times.size - 2)
+    leg = leg_at(times, extra)
     fraction = ((extra - times[leg]) / (times[leg + 1] - times[leg]))[:, None, None]
     # (1 - f) a + f b, as Plan.position evaluates x, kept per coordinate between a and b,
     # where the exact point lies: rounded, (1 - f) a + f a can be an ulp off a, and a robot

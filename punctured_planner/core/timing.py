@@ -20,6 +20,16 @@ import numpy.typing as npt
 CORNER_SHARE = 0.1
 
 
+def leg_at(times: np.ndarray, at: npt.ArrayLike) -> np.ndarray:
+    """
+    Return the leg j, [times[j], times[j + 1]), holding each time of at (same shape).
+
+    times (V,) are a motion's breakpoint times (or stamps), V >= 2; a time at or
+    beyond the last one is in the last leg, one before the first in the first.
+    """
+    return np.clip(np.searchsorted(times, at, side='right') - 1, 0, max(times.size - 2, 0))
+
+
 def leg_lengths(positions: np.ndarray) -> np.ndarray:
     """Return the (V - 1,) largest robot displacement along each leg."""
     steps = positions[1:] - positions[:-1]  # np.diff's own difference, without its wrapper

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.timing import corner_jump, fleet_profile, speed_profile, SpeedProfile
+from ..core.timing import corner_jump, fleet_profile, leg_at, speed_profile, SpeedProfile
 
 
 @dataclass(frozen=True)
@@ -92,9 +92,7 @@ class Reference:
 
     def _interval(self, s: float) -> int:
         """Return the index j of the stamp interval [seconds[j], seconds[j+1]) holding s."""
-        last = self.seconds.size - 2
-        return int(np.clip(np.searchsorted(self.seconds, s, side='right') - 1, 0,
-                           max(last, 0)))
+        return int(leg_at(self.seconds, s))
 
     def _along(self, j: int, s: float) -> tuple[float, float, float]:
         """

@@ -30,6 +30,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core.timing import leg_at
+
 # The lead e as a fraction of the tracking tolerance delta (capped by the clock's
 # fractions, see lead()): small enough that the start (E = 2e) runs at full rate.
 LEAD_FRACTION = 0.1
@@ -223,11 +225,6 @@ class Corners:
             result[moves[1:][np.abs(beta) > REVERSE_ANGLE]] = True
         return result
 
-    def interval(self, s: float) -> int:
-        """Return the index of the interval holding plan time s (its last one from the end)."""
-        return int(np.clip(np.searchsorted(self.seconds, s, side='right') - 1, 0,
-                           max(self.seconds.size - 2, 0)))
-
     def upcoming(self, s: float) -> tuple:
         """
         Return (directions (k, 3), still_until (k,)): where each reference moves next, and when.
@@ -239,7 +236,7 @@ class Corners:
         k = self.speeds.shape[1] if self.speeds.size else 0
         if self.speeds.size == 0 or s >= self.seconds[-1]:
             return np.zeros((k, 3)), np.full(k, np.inf)
-        j = self.interval(s)
+        j = int(leg_at(self.seconds, s))
         nxt = self.next_moving[j]
         has = nxt < len(self.speeds)
         rows = np.minimum(nxt, len(self.speeds) - 1)

@@ -17,6 +17,7 @@ from PIL import Image
 from .canvas import robot_colours
 from .geometry import plane_view
 from .picture import plan_figure, plan_title
+from ..core.timing import leg_at
 
 
 def _allocate(durations, budget):
@@ -56,8 +57,7 @@ def frame_parameters(plan, frame_count, max_speed=1.0):
 
 def _leg_label(plan, tau):
     """Return 'C_m -> C_m+1: <leg name>' for the leg that contains tau."""
-    legs = len(plan.leg_names)
-    leg = int(np.clip(np.searchsorted(plan.times, tau, side='right') - 1, 0, legs - 1))
+    leg = int(leg_at(plan.times, tau))
     segment = plan.segment_of(leg)
     return f'C_{segment + 1} -> C_{segment + 2}: {plan.leg_names[leg]}'
 
