@@ -306,6 +306,12 @@ def progress_printer():
                                file=sys.stderr, flush=True)
 
 
+def grid_report(settings, run, summary, table):
+    """Run a grid benchmark on settings; return its Markdown lines: the headline, the table."""
+    results = run(settings, progress_printer())
+    return summary(results) + ['', format_table(table(results))]
+
+
 def grid_main(doc, report, quick_settings, settings, argv=None):
     """Run a grid benchmark from the command line: ``--quick`` for its smoke grid."""
     parser = argparse.ArgumentParser(description=doc.strip().splitlines()[0])

@@ -18,10 +18,10 @@ Run alone: ``.venv/bin/python bench/hall.py [--quick]``.
 from dataclasses import dataclass
 import time
 
-from core_speed import format_table, grid_main, progress_printer
+from core_speed import grid_main, grid_report
 import numpy as np
 from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
-from refinement import PILLAR, RADIUS, realistic_fleet
+from refinement import each_fleet, PILLAR, RADIUS
 
 MARGIN = 0.15
 # Seeds of the hidden fleets: far from bench/refinement.py's 100 k + 10 d + seed.
@@ -92,16 +92,10 @@ def quick_settings() -> Settings:
 
 def run(settings: Settings, progress=None) -> list[Outcome]:
     """Return the Outcome of every fleet of the grid."""
-    outcomes = []
-    for k in settings.ks:
-        for seed in range(settings.seeds if k <= 40 else settings.large_seeds):
-            fleet = realistic_fleet(k, 2, settings.seed_base + 1000 * k + seed)
-            if fleet is None:
-                continue
-            if progress:
-                progress(f'k={k} seed={seed}')
-            outcomes.append(run_one(fleet))
-    return outcomes
+    fleets = each_fleet(settings.ks,
+                        lambda k: settings.seeds if k <= 40 else settings.large_seeds,
+                        lambda k, seed: settings.seed_base + 1000 * k + seed, progress)
+    return [run_one(fleet) for fleet in fleets]
 
 
 def _share(outcomes, code) -> str:
@@ -140,8 +134,7 @@ def summary(outcomes: list[Outcome]) -> list[str]:
 
 def report(settings: Settings) -> list[str]:
     """Run the benchmark; return its Markdown lines: the headline, then the table."""
-    outcomes = run(settings, progress_printer())
-    return summary(outcomes) + ['', format_table(table(outcomes))]
+    return grid_report(settings, run, summary, table)
 
 
 def main(argv=None):

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field, replace
 import sys
 import time
 
-from core_speed import format_table, grid_main, progress_printer
+from core_speed import grid_main, grid_report
 import numpy as np
 import peers
 
@@ -81,6 +81,18 @@ def realistic_fleet(k, d, seed, n=3):
     if any(c is None for c in configurations):
         return None
     return Fleet(k, d, seed, pillars, np.array(configurations))
+
+
+def each_fleet(ks, seeds, seed_of, progress=None):
+    """Yield the realistic fleets in the plane: seeds(k) per k, seeded by seed_of(k, seed)."""
+    for k in ks:
+        for seed in range(seeds(k)):
+            fleet = realistic_fleet(k, 2, seed_of(k, seed))
+            if fleet is None:
+                continue
+            if progress:
+                progress(f'k={k} seed={seed}')
+            yield fleet
 
 
 def straight_length(configurations):
@@ -299,8 +311,7 @@ def summary(results):
 
 def report(settings):
     """Run the benchmark; return its Markdown lines: the targets, then the table."""
-    results = run(settings, progress_printer())
-    return summary(results) + ['', format_table(table(results))]
+    return grid_report(settings, run, summary, table)
 
 
 def main(argv=None):

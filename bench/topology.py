@@ -28,11 +28,11 @@ Run alone: ``.venv/bin/python bench/topology.py [--quick]``.
 from contextlib import contextmanager
 from dataclasses import dataclass
 
-from core_speed import format_table, grid_main, progress_printer
+from core_speed import grid_main, grid_report
 import numpy as np
 from punctured_planner.core import plan, Workspace
 from punctured_planner.core import refine as refinement_stage
-from refinement import PILLAR, RADIUS, realistic_fleet, straight_length
+from refinement import each_fleet, PILLAR, RADIUS, straight_length
 from scipy.optimize import linprog
 
 # Enough blocks for the caps' fixed point: 100 and 400 give the same medians to 0.01.
@@ -182,16 +182,10 @@ def quick_settings() -> Settings:
 
 def run(settings: Settings, progress=None) -> list[Outcome]:
     """Return the Outcome of every fleet of the grid."""
-    outcomes = []
-    for k in settings.ks:
-        for seed in range(settings.seeds):
-            fleet = realistic_fleet(k, 2, 100 * k + 20 + seed)
-            if fleet is None:
-                continue
-            if progress:
-                progress(f'k={k} seed={seed}')
-            outcomes.append(run_one(fleet))
-    return outcomes
+    # bench/refinement.py's seeds in the plane: 100 k + 10 d + seed.
+    fleets = each_fleet(settings.ks, lambda k: settings.seeds,
+                        lambda k, seed: 100 * k + 20 + seed, progress)
+    return [run_one(fleet) for fleet in fleets]
 
 
 def table(outcomes: list[Outcome]) -> list[tuple]:
@@ -224,15 +218,10 @@ def summary(outcomes: list[Outcome]) -> list[str]:
     ]
 
 
-def report(settings: Settings) -> list[str]:
-    """Run the benchmark; return its Markdown lines: the headline, then the table."""
-    outcomes = run(settings, progress_printer())
-    return summary(outcomes) + ['', format_table(table(outcomes))]
-
-
 def main(argv=None):
-    """Run the benchmark and print its figures."""
-    grid_main(__doc__, report, quick_settings, Settings, argv)
+    """Run the benchmark and print its headline and table."""
+    grid_main(__doc__, lambda settings: grid_report(settings, run, summary, table),
+              quick_settings, Settings, argv)
 
 
 if __name__ == '__main__':
