@@ -13,9 +13,10 @@ from core_strategies import lattice_requests, requests
 from hypothesis import given, HealthCheck, settings, strategies as st
 import numpy as np
 from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
+from punctured_planner.core.errors import Wall
 from punctured_planner.core.validation import validate_configurations
 from punctured_planner.core.walls import (checked_bounds, first_outside, smallest_leg_slack,
-                                          Wall, wall_slack)
+                                          wall_slack)
 import pytest
 from test_core_refine import refined_with_walls
 

@@ -15,11 +15,11 @@ service response. Free text put into a template goes through :func:`literal`.
 """
 
 from collections.abc import Iterable
+from dataclasses import dataclass
 import enum
-from typing import Any, TYPE_CHECKING
+from typing import Any
 
-if TYPE_CHECKING:  # walls imports this module
-    from .walls import Wall
+import numpy as np
 
 
 class ErrorCode(enum.IntEnum):
@@ -52,6 +52,37 @@ class ErrorCode(enum.IntEnum):
     UNKNOWN = 99
 
 
+# The names of the first coordinate axes (a wall's culprit words).
+_AXES = 'xyz'
+
+
+def axis_name(axis: int) -> str:
+    """Return the name of coordinate axis: x, y, z, then x3, x4, ..."""
+    return _AXES[axis] if axis < len(_AXES) else f'x{axis}'
+
+
+@dataclass(frozen=True)
+class Wall:
+    """One wall of the box: the side min (high False) or max (high True) of an axis."""
+
+    axis: int
+    high: bool
+
+    @property
+    def name(self) -> str:
+        """Return the wall's name: 'x_min', 'y_max', ... ('x3_min' beyond z)."""
+        return f'{axis_name(self.axis)}_{"max" if self.high else "min"}'
+
+    @property
+    def index(self) -> int:
+        """Return the wall's index in bounds.ravel(): x_min, x_max, y_min, ..."""
+        return 2 * self.axis + int(self.high)
+
+    def position(self, bounds: np.ndarray) -> float:
+        """Return the wall's coordinate in bounds (d, 2)."""
+        return float(bounds[self.axis, int(self.high)])
+
+
 def literal(text: object) -> str:
     """Return text with its braces doubled: free text inside a message template."""
     return str(text).replace('{', '{{').replace('}', '}}')
@@ -76,7 +107,7 @@ class Names:
         """Return the name of several obstacles: 'obstacles 0 and 3'."""
         return 'obstacles ' + ' and '.join(str(j) for j in indices)
 
-    def wall(self, wall: 'Wall') -> str:
+    def wall(self, wall: Wall) -> str:
         """Return the name of a wall of the workspace bounds: 'the wall x_max'."""
         return f'the wall {wall.name}'
 
@@ -126,7 +157,7 @@ class PlanningError(ValueError):
                  robots: Iterable[int] = (), obstacle: int | None = None,
                  obstacles: Iterable[int] = (), coordinate: int | None = None,
                  point: Any = None, clearance: Any = None, gap: Any = None,
-                 wall: 'Wall | None' = None, distance: float | None = None,
+                 wall: Wall | None = None, distance: float | None = None,
                  leg: int | None = None) -> None:
         """Store the code and the culprits; message is the reason's template."""
         self.code = ErrorCode(code)

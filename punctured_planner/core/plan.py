@@ -28,7 +28,7 @@ from .strata import epsilon, projection_count, projection_gaps
 from .timing import (corner_jump, leg_at, length_times, resample, speed_profile, SpeedProfile,
                      stamps as timed_stamps)
 from .validation import validate_configurations
-from .walls import check_plan_inside
+from .walls import smallest_leg_slack
 
 
 @dataclass(frozen=True, eq=False)
@@ -323,7 +323,7 @@ def plan(workspace: Workspace, configurations: npt.ArrayLike, certify: bool = Tr
         result = _refined(result)
     if certify:
         _check_required_clearance(result)
-    check_plan_inside(result)
+    _check_inside(result)
     return result
 
 
@@ -367,7 +367,7 @@ def _refined(raw):
                                            bodies))
 
 
-def _check_required_clearance(result):
+def _check_required_clearance(result: Plan) -> None:
     """
     Raise CLEARANCE_BELOW_REQUIRED if the certified clearance is not enough.
 
@@ -400,3 +400,29 @@ def _check_required_clearance(result):
         configuration=segment, robots=[a] if certificate.kind == 'obstacle' else [a, b],
         obstacle=b if certificate.kind == 'obstacle' else None, clearance=result.clearance,
         gap=result.gap if trusted else None)
+
+
+def _check_inside(result: Plan) -> None:
+    """
+    Raise OUTSIDE_WORKSPACE if some robot of result leaves its workspace's bounds.
+
+    Exact (smallest_leg_slack); the error names the robot, the wall, how far
+    beyond it the robot reaches, and the first leg that reaches that far.
+    """
+    workspace = result.workspace
+    bounds = workspace.bounds
+    if bounds is None:
+        return
+    worst = smallest_leg_slack(result.positions, bounds, workspace.robot_radius)
+    if worst.slack >= 0:
+        return
+    leg = worst.index
+    ends = result.positions[leg:leg + 2, worst.body, worst.wall.axis]
+    centre = float(ends.max() if worst.wall.high else ends.min())
+    raise PlanningError(
+        ErrorCode.OUTSIDE_WORKSPACE,
+        f'the plan takes robot {worst.body} '
+        f'{worst.words(bounds, centre, workspace.robot_radius, "robot_radius")} on leg {leg} '
+        f'({result.leg_names[leg]} of segment {{waypoint}} -> {{next_waypoint}})',
+        configuration=result.segment_of(leg), robots=[worst.body], wall=worst.wall,
+        distance=worst.beyond, leg=leg)

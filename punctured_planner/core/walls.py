@@ -13,44 +13,11 @@ whole motion (doc/design.md section 17).
 """
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 import numpy.typing as npt
 
-from .errors import ErrorCode, PlanningError
-
-if TYPE_CHECKING:  # plan imports this module
-    from .plan import Plan
-
-_AXES = 'xyz'
-
-
-def axis_name(axis: int) -> str:
-    """Return the name of coordinate axis: x, y, z, then x3, x4, ..."""
-    return _AXES[axis] if axis < len(_AXES) else f'x{axis}'
-
-
-@dataclass(frozen=True)
-class Wall:
-    """One wall of the box: the side min (high False) or max (high True) of an axis."""
-
-    axis: int
-    high: bool
-
-    @property
-    def name(self) -> str:
-        """Return the wall's name: 'x_min', 'y_max', ... ('x3_min' beyond z)."""
-        return f'{axis_name(self.axis)}_{"max" if self.high else "min"}'
-
-    @property
-    def index(self) -> int:
-        """Return the wall's index in bounds.ravel(): x_min, x_max, y_min, ..."""
-        return 2 * self.axis + int(self.high)
-
-    def position(self, bounds: np.ndarray) -> float:
-        """Return the wall's coordinate in bounds (d, 2)."""
-        return float(bounds[self.axis, int(self.high)])
+from .errors import axis_name, ErrorCode, PlanningError, Wall
 
 
 @dataclass(frozen=True)
@@ -201,29 +168,3 @@ def smallest_leg_slack(positions: npt.ArrayLike, bounds: np.ndarray,
     vertex, entry = np.unravel_index(int(np.argmin(flat)), flat.shape)
     found = _slack_at(slack, int(vertex), int(entry))
     return WallSlack(max(found.index - 1, 0), found.body, found.wall, found.slack)
-
-
-def check_plan_inside(plan: 'Plan') -> None:
-    """
-    Raise OUTSIDE_WORKSPACE if some robot of plan leaves its workspace's bounds.
-
-    Exact (smallest_leg_slack); the error names the robot, the wall, how far
-    beyond it the robot reaches, and the first leg that reaches that far.
-    """
-    workspace = plan.workspace
-    bounds = workspace.bounds
-    if bounds is None:
-        return
-    worst = smallest_leg_slack(plan.positions, bounds, workspace.robot_radius)
-    if worst.slack >= 0:
-        return
-    leg = worst.index
-    ends = plan.positions[leg:leg + 2, worst.body, worst.wall.axis]
-    centre = float(ends.max() if worst.wall.high else ends.min())
-    raise PlanningError(
-        ErrorCode.OUTSIDE_WORKSPACE,
-        f'the plan takes robot {worst.body} '
-        f'{worst.words(bounds, centre, workspace.robot_radius, "robot_radius")} on leg {leg} '
-        f'({plan.leg_names[leg]} of segment {{waypoint}} -> {{next_waypoint}})',
-        configuration=plan.segment_of(leg), robots=[worst.body], wall=worst.wall,
-        distance=worst.beyond, leg=leg)

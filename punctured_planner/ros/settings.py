@@ -23,8 +23,8 @@ from .parameters import Spec
 from .parameters import Table
 from .parameters import within
 from ..core import VARIANTS
+from ..core.errors import Wall
 from ..core.walls import checked_bounds
-from ..core.walls import Wall
 from ..execution import Bodies
 from ..execution import DRIVES
 from ..execution import ExecutionSettings

@@ -15,7 +15,7 @@ from typing import Sequence
 
 from .snapshot import ObstacleSet
 from ..core.errors import Names
-from ..core.walls import Wall
+from ..core.errors import Wall
 
 
 class ObstacleNames(Names):
