@@ -23,9 +23,10 @@ the fixed point sampled at OPTIMUM_KNOTS times a segment and shortened by
 L-BFGS (scipy) against a barrier on every gap at the samples, so that no
 winding can change (checked); being sampled, it may come a few millimetres
 under the margin between samples, which the table reports. All on
-bench/refinement.py's realistic disc fleets in the plane, with its seeds.
-Checked on every fleet: every one of these motions sweeps the construction's
-angles (the topology kept).
+bench/refinement.py's realistic disc fleets in the plane, with its seeds, with
+how far the refined motion and the local optimum leave the box of
+configurations and pillars (its excursion). Checked on every fleet: every one
+of these motions sweeps the construction's angles (the topology kept).
 
 Run alone: ``.venv/bin/python bench/topology.py [--quick]``.
 """
@@ -38,7 +39,7 @@ import numpy as np
 from punctured_planner.core import plan, Workspace
 from punctured_planner.core import refine as refinement_stage
 from punctured_planner.core.certificate import certify
-from refinement import each_fleet, PILLAR, RADIUS, straight_length
+from refinement import each_fleet, excursion, PILLAR, RADIUS, straight_length
 from scipy.optimize import linprog, minimize
 
 # Enough blocks for the caps' fixed point: 100 and 400 give the same medians to 0.01.
@@ -65,6 +66,8 @@ class Outcome:
     optimum: float
     optimum_shortfall: float
     floor: float
+    refined_excursion: float
+    optimum_excursion: float
 
 
 @dataclass
@@ -253,7 +256,8 @@ def run_one(fleet) -> Outcome:
     outcome = Outcome(fleet.k, _length(raw) / straight, _length(refined) / straight,
                       _length(fixed) / straight, _length(optimum) / straight,
                       max(shortfall, 0.0),
-                      floor_ratio(raw, fleet.pillars, refined.margin, straight))
+                      floor_ratio(raw, fleet.pillars, refined.margin, straight),
+                      excursion(refined.positions, fleet), excursion(optimum.positions, fleet))
     # A floor above a motion of that topology would be no floor.
     assert outcome.floor <= min(outcome.refined, outcome.fixed_point, outcome.optimum), outcome
     return outcome
@@ -289,14 +293,17 @@ def table(outcomes: list[Outcome]) -> list[tuple]:
     """Return the rows per k: median length ratios, the optimum's shortfall and the floor."""
     rows = [('k', 'fleets', 'construction', f'refined ({refinement_stage.BLOCKS} blocks)',
              f"caps' fixed point ({FIXED_POINT_BLOCKS} blocks)", 'local optimum (L-BFGS)',
-             'its largest shortfall under the margin, mm', 'floor of the topology')]
+             'its largest shortfall under the margin, mm', 'floor of the topology',
+             'excursion: refined, local optimum')]
     for k in sorted({o.k for o in outcomes}):
         group = [o for o in outcomes if o.k == k]
         rows.append((str(k), str(len(group)), f'{_median(group, "construction"):.2f}',
                      f'{_median(group, "refined"):.2f}', f'{_median(group, "fixed_point"):.2f}',
                      f'{_median(group, "optimum"):.2f}',
                      f'{1e3 * max(o.optimum_shortfall for o in group):.1f}',
-                     f'{_median(group, "floor"):.2f}'))
+                     f'{_median(group, "floor"):.2f}',
+                     f'{100 * _median(group, "refined_excursion"):.0f}%, '
+                     f'{100 * _median(group, "optimum_excursion"):.0f}%'))
     return rows
 
 
