@@ -10,7 +10,9 @@ inside the walls (checked here again, independently: every breakpoint's disc
 inside) or is refused with OUTSIDE_WORKSPACE; the benchmark asserts that nothing
 comes back outside. Figures per k: the share planned inside, the share refused,
 any other refusal, and for the refused the median distance beyond the wall as a
-share of the box's longest side.
+share of the box's longest side; and the refined plan's length over the
+straight-line bound, planned without the walls' refusal in the frame the walls
+choose (core.frame.choose_frame) and in the default frame, side by side.
 
 Run alone: ``.venv/bin/python bench/hall.py [--quick]``.
 """
@@ -21,7 +23,7 @@ import time
 from core_speed import grid_main, grid_report
 import numpy as np
 from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
-from refinement import each_fleet, PILLAR, RADIUS
+from refinement import each_fleet, PILLAR, RADIUS, straight_length
 
 MARGIN = 0.15
 # Seeds of the hidden fleets: far from bench/refinement.py's 100 k + 10 d + seed.
@@ -34,6 +36,8 @@ class Outcome:
 
     k: int
     code: ErrorCode
+    length: float
+    default_length: float
     beyond: float = float('nan')
     seconds: float = float('nan')
 
@@ -58,21 +62,32 @@ def inside(positions: np.ndarray, bounds: np.ndarray) -> bool:
                 and (bounds[:, 1] - positions - RADIUS >= -rounding).all())
 
 
+def _length_ratio(fleet, frame=None) -> float:
+    """Return the refined plan's length / straight-line bound without walls, in a frame."""
+    workspace = Workspace(fleet.pillars, variant='discs', robot_radius=RADIUS,
+                          obstacle_radius=PILLAR, frame=frame)
+    result = plan(workspace, fleet.configurations, certify=False)
+    travel = float(np.linalg.norm(np.diff(result.positions, axis=0), axis=2).sum())
+    return travel / straight_length(fleet.configurations)
+
+
 def run_one(fleet) -> Outcome:
     """Plan one fleet in its hall; assert a returned plan is inside."""
     bounds = hall(fleet)
     side = float((bounds[:, 1] - bounds[:, 0]).max()) / (1 + 2 * MARGIN)
     workspace = Workspace(fleet.pillars, variant='discs', robot_radius=RADIUS,
                           obstacle_radius=PILLAR, bounds=bounds)
+    # Lengths with the walls' frame and with the default one, the walls' refusal left out.
+    lengths = _length_ratio(fleet, workspace.frame), _length_ratio(fleet)
     begin = time.perf_counter()
     try:
         result = plan(workspace, fleet.configurations)
     except PlanningError as error:
         beyond = error.distance / side if error.code == ErrorCode.OUTSIDE_WORKSPACE else np.nan
-        return Outcome(fleet.k, error.code, beyond, time.perf_counter() - begin)
+        return Outcome(fleet.k, error.code, *lengths, beyond, time.perf_counter() - begin)
     seconds = time.perf_counter() - begin
     assert inside(result.positions, bounds), f'k={fleet.k} seed={fleet.seed}: came back outside'
-    return Outcome(fleet.k, ErrorCode.NONE, 0.0, seconds)
+    return Outcome(fleet.k, ErrorCode.NONE, *lengths, 0.0, seconds)
 
 
 @dataclass
@@ -107,7 +122,8 @@ def _share(outcomes, code) -> str:
 def table(outcomes: list[Outcome]) -> list[tuple]:
     """Return the rows per k: shares planned inside, refused outside, refused otherwise."""
     rows = [('k', 'fleets', 'planned inside', 'refused OUTSIDE_WORKSPACE', 'other refusals',
-             'beyond the wall / side, median (refused)', 'plan ms, median')]
+             'beyond the wall / side, median (refused)', 'plan ms, median',
+             "length / straight line: walls' frame, default frame")]
     for k in sorted({o.k for o in outcomes}):
         group = [o for o in outcomes if o.k == k]
         others = [o.code.name for o in group
@@ -117,7 +133,9 @@ def table(outcomes: list[Outcome]) -> list[tuple]:
                      _share(group, ErrorCode.OUTSIDE_WORKSPACE),
                      ', '.join(others) or '0',
                      f'{100 * np.median(beyond):.0f}%' if beyond else '-',
-                     f'{1e3 * np.median([o.seconds for o in group]):.1f}'))
+                     f'{1e3 * np.median([o.seconds for o in group]):.1f}',
+                     f'{np.median([o.length for o in group]):.2f}, '
+                     f'{np.median([o.default_length for o in group]):.2f}'))
     return rows
 
 

@@ -191,8 +191,8 @@ def test_a_plan_is_inside_its_bounds_or_refused_naming_where_it_leaves(
         assert error.code == ErrorCode.OUTSIDE_WORKSPACE, str(error)
         robot, axis, leg = error.robots[0], error.wall.axis, error.leg
         # The refined motion the refusal judged: the construction's, refined against the walls.
-        raw = plan(Workspace(obstacles, dimension=configurations.shape[2], variant=variant),
-                   configurations, refine=False)
+        raw = plan(Workspace(obstacles, dimension=configurations.shape[2], variant=variant,
+                             frame=workspace.frame), configurations, refine=False)
         ends = refined_with_walls(raw, bounds).positions[leg:leg + 2, robot, axis]
         high, low = ends.max() - bounds[axis, 1], bounds[axis, 0] - ends.min()
         beyond = high if error.wall.high else low
@@ -223,7 +223,9 @@ def test_disc_plans_keep_their_radius_from_every_wall_or_are_refused(case, margi
     except PlanningError as error:
         assert error.code == ErrorCode.OUTSIDE_WORKSPACE, str(error)
         # the motion the refusal judged: the construction's, refined against the walls
-        free = plan(workspace, configurations, refine=False)
+        free = plan(Workspace(workspace.obstacles, variant='discs', robot_radius=radius,
+                              obstacle_radius=rho, frame=walled.frame),
+                    configurations, refine=False)
         free = (refined_with_walls(free, bounds) if refine else free).positions
         leg, robot, wall = error.leg, error.robots[0], error.wall
         ends = free[leg:leg + 2, robot, wall.axis]
@@ -304,3 +306,26 @@ def test_outside_workspace_ranks_beside_robot_on_obstacle_and_clearance_below_re
                                 tight).positions
     assert error.value.distance == pytest.approx(
         max((judged - tight[:, 1]).max(), (tight[:, 0] - judged).max()))
+
+
+def test_the_walls_choose_the_axis_frame_with_the_most_room_beyond_the_obstacles():
+    """A pillar by the top wall: staging below the pillars fits where staging above cannot."""
+    hall = np.array([[0.0, 6.0], [0.0, 6.0]])
+    pillars = np.array([[1.0, 5.3], [3.0, 2.0], [4.5, 3.0]])
+    # Two robots low in the hall trade places: their projection order reverses.
+    configurations = np.array([[[2.0, 0.8], [4.0, 0.8]], [[4.0, 1.2], [2.0, 1.2]]])
+    bodies = dict(variant='discs', robot_radius=0.2, obstacle_radius=0.15)
+    walled = Workspace(pillars, bounds=hall, **bodies)
+    # Room along e2 = +y: 6 - 5.3; -y: 2.0 - 0; +x: 6 - 4.5; -x: 1.0 - 0.
+    assert np.array_equal(walled.frame.e1, [1.0, 0.0])
+    assert np.array_equal(walled.frame.e2, [0.0, -1.0])
+    assert np.array_equal(Workspace(pillars, **bodies).frame.e2, [0.0, 1.0])
+    result = plan(walled, configurations)
+    assert (result.positions - 0.2 >= hall[:, 0]).all()
+    assert (result.positions + 0.2 <= hall[:, 1]).all()
+    axes = Workspace(pillars, bounds=hall, frame=((0.0, 0.0), (1.0, 0.0), (0.0, 1.0)),
+                     **bodies)
+    with pytest.raises(PlanningError) as refused:
+        plan(axes, configurations)
+    assert refused.value.code == ErrorCode.OUTSIDE_WORKSPACE
+    assert refused.value.wall == Wall(1, True), str(refused.value)

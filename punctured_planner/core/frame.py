@@ -65,24 +65,52 @@ def _moment_curve_directions(dimension, count):
     return directions / np.linalg.norm(directions, axis=1, keepdims=True)
 
 
-def choose_frame(obstacles: np.ndarray) -> Frame:
+def _axis_frames(d):
     """
-    Return the default frame for obstacles (r, d): deterministic, fixed per obstacle set.
+    Yield the axis frames (a, b, s): e1 the axis a, e2 the axis b (b != a) times s = +-1.
+
+    In a fixed order: a, then b from a + 1 on (cyclically), then + before -; the
+    first is (0, 1, +1), the coordinate axes.
+    """
+    for a in range(d):
+        for step in range(1, d):
+            for sign in (1.0, -1.0):
+                yield a, (a + step) % d, sign
+
+
+def _room(obstacles, bounds, b, sign):
+    """Return how far the wall that e2 = sign x axis b points to lies beyond every obstacle."""
+    wall = bounds[b, 1] if sign > 0 else -bounds[b, 0]
+    return float(wall - (sign * obstacles[:, b]).max())
+
+
+def choose_frame(obstacles: np.ndarray, bounds: np.ndarray | None = None) -> Frame:
+    """
+    Return the default frame for obstacles (r, d): deterministic, fixed per workspace.
 
     The coordinate axes (o = 0, e1 = x, e2 = y) whenever the obstacles' x
     coordinates are distinct; otherwise the next coordinate axis that works;
     otherwise the moment-curve direction that maximises the smallest gap between
-    obstacle projections.
+    obstacle projections. With walls (bounds (d, 2)) and obstacles, the axis
+    frame (e1 a coordinate axis that separates them, e2 another one either way)
+    with the most room between the wall e2 points to and the farthest obstacle
+    along e2, where the construction stages and runs its lanes (the first of
+    _axis_frames on a tie; doc/design.md section 17).
     """
     r, d = obstacles.shape
     origin = np.zeros(d)
-    for a in range(d):
-        if r < 2 or np.all(np.diff(np.sort(obstacles[:, a])) > 0):
-            e1 = np.zeros(d)
-            e1[a] = 1.0
-            e2 = np.zeros(d)
-            e2[(a + 1) % d] = 1.0
-            return Frame(origin, e1, e2)
+    separating = [a for a in range(d)
+                  if r < 2 or np.all(np.diff(np.sort(obstacles[:, a])) > 0)]
+    frames = [(a, b, sign) for a, b, sign in _axis_frames(d) if a in separating]
+    if frames:
+        if bounds is not None and r:
+            rooms = [_room(obstacles, bounds, b, sign) for _, b, sign in frames]
+            a, b, sign = frames[int(np.argmax(rooms))]
+        else:
+            a, b, sign = frames[0]
+        e1, e2 = np.zeros(d), np.zeros(d)
+        e1[a], e2[b] = 1.0, sign
+        return Frame(origin, e1, e2)
     count = max(16, (r * (r - 1) // 2) * (d - 1) + 1)
     directions = _moment_curve_directions(d, count)
     gaps = np.diff(np.sort(obstacles @ directions.T, axis=0), axis=0).min(axis=0)

@@ -41,7 +41,7 @@ class Workspace:
     the centre distance for point robots and obstacles, the surface gap
     (Plan.min_gap) as soon as a radius is set.
     ``frame`` is the core's own Frame or (origin, e1, e2); by default the
-    frame is chosen from the obstacles (choose_frame).
+    frame is chosen from the obstacles and the walls (choose_frame).
     ``bounds`` (d, 2), [low, high] per axis in the configurations' own
     coordinates (core.walls), are the walls of the room: every robot and
     pillar must stay inside, a disc keeping its radius from every wall
@@ -90,7 +90,7 @@ class Workspace:
         self.robot_radius, self.obstacle_radii = _checked_radii(robot_radius, obstacle_radius,
                                                                 len(obstacles))
         self._reject_coincident_obstacles()
-        self.frame = (choose_frame(obstacles) if frame is None
+        self.frame = (choose_frame(obstacles, self.bounds) if frame is None
                       else checked_frame(frame, self.dimension))
         self.obstacle_projections = self.frame.project(obstacles)
         same = _coincident_pair(self.obstacle_projections)
