@@ -314,7 +314,7 @@ def test_the_walls_choose_the_axis_frame_with_the_most_room_beyond_the_obstacles
     pillars = np.array([[1.0, 5.3], [3.0, 2.0], [4.5, 3.0]])
     # Two robots low in the hall trade places: their projection order reverses.
     configurations = np.array([[[2.0, 0.8], [4.0, 0.8]], [[4.0, 1.2], [2.0, 1.2]]])
-    bodies = dict(variant='discs', robot_radius=0.2, obstacle_radius=0.15)
+    bodies = {'variant': 'discs', 'robot_radius': 0.2, 'obstacle_radius': 0.15}
     walled = Workspace(pillars, bounds=hall, **bodies)
     # Room along e2 = +y: 6 - 5.3; -y: 2.0 - 0; +x: 6 - 4.5; -x: 1.0 - 0.
     assert np.array_equal(walled.frame.e1, [1.0, 0.0])
