@@ -225,3 +225,23 @@ def test_the_rise_ends_every_robot_at_its_compressed_height_unpushed(count):
         assert np.all(motion.lift == motion.lift[:, :1])
     else:  # the robot far above top does not move, the lowest rises to top exactly
         assert np.all(motion.lift[:, 0] == 0) and h[-1] + motion.lift[-1, -1] == layout.top
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(2, 9), st.floats(-1e4, 1e4), st.floats(-1e4, 1e4), st.integers(0, 2 ** 16))
+def test_without_pillars_the_motion_stays_by_the_fleet_wherever_the_origin_is(
+        count, x, y, seed):
+    """No pillar to clear: the lanes are centred on the fleet, not on the axis h = 0."""
+    rng = np.random.default_rng(seed)
+    # Robots 1 m apart on a jittered grid around (x, y), three configurations.
+    grid = np.stack(np.meshgrid(np.arange(3.0), np.arange(3.0)), axis=-1).reshape(-1, 2)
+    configurations = np.array([grid[rng.permutation(9)[:count]] + [x, y]
+                               + rng.uniform(-0.1, 0.1, (count, 2)) for _ in range(3)])
+    result = plan(Workspace(np.zeros((0, 2)), variant='discs', robot_radius=0.2),
+                  configurations)
+    pitch = result.workspace.disc_layout.pitch
+    # Within the configurations' e2 range widened by k lanes.
+    heights = configurations[..., 1]
+    assert result.positions[..., 1].min() >= heights.min() - count * pitch
+    assert result.positions[..., 1].max() <= heights.max() + count * pitch
+    assert result.min_gap >= result.margin > 0

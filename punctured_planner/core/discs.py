@@ -41,9 +41,11 @@ The construction keeps the paper's skeleton, H(C_m), Gamma, H(C_{m+1})^-1
   column of slot rank(x) (the hyperplane p = that slot); slots
   g = max(min_spacing, 2R + nu) apart along e1, centred on the mean robot
   projection; rank orders robots by projection, ties by index. A slot is its
-  column at height top (the axis' height when there are no pillars, and no
-  rise), the robot's coordinates across e1 and e2 kept (d >= 3): the staging
-  line in the plane, the staging hyperplane h = top in 3-D.
+  column at height top, the robot's coordinates across e1 and e2 kept
+  (d >= 3): the staging line in the plane, the staging hyperplane h = top in
+  3-D. Without pillars there is no rise and no height to clear: each segment's
+  staging height centres its lanes on the mean e2 offset of its two
+  configurations (staging_height).
 * Gamma between base configurations (the paper's section, equation 3.1, with
   shared lanes): every robot moves along e2 within its column to its lane
   top + l g (lane 0 is the staging height itself), slides at that height to
@@ -318,6 +320,21 @@ class DiscSection:
     lane_heights: np.ndarray
 
 
+def staging_height(layout: DiscLayout, offsets: np.ndarray, top_lane: int) -> float:
+    """
+    Return a segment's staging height: top, or without pillars the fleet's middle.
+
+    offsets (2, k) are the robots' e2 offsets in the segment's two
+    configurations, top_lane its highest lane. Without pillars no height needs
+    clearing, and the lanes are centred on the mean offset: a continuous
+    function of the two configurations, near the fleet wherever the frame's
+    origin lies (the axis, h = 0, can be far from it).
+    """
+    if layout.reach.size:
+        return layout.top
+    return float(offsets.mean()) - 0.5 * top_lane * layout.pitch
+
+
 def section(configurations: np.ndarray, layout: DiscLayout) -> DiscSection:
     """
     Return the disc section through configurations (n, k, d): H(C_m), Gamma, H(C_{m+1})^-1.
@@ -334,18 +351,22 @@ def section(configurations: np.ndarray, layout: DiscLayout) -> DiscSection:
         risen = rise(p, h, layout).positions(configuration, layout.frame)
         names = [SIDESTEP] + [RISE] * (len(risen) - 2)
         rank = staging_ranks(p)
-        # The gather moves along e1 only, into the slots' columns, at the risen heights; a
-        # slot is its column at height top, other coordinates (d >= 3) kept.
+        # The gather moves along e1 only, into the slots' columns, at the risen heights.
         columns = risen[-1] + (staging_slots(p, rank, layout.pitch) - p)[:, None] * e1
-        slots = columns + (layout.top - layout.frame.offset(columns))[:, None] * e2
-        deformations.append((risen, names, rank, slots, columns))
+        deformations.append((risen, names, rank, columns))
     stages, names, ends, heights = [configurations[0]], [''], [], set()
     for m in range(n - 1):
-        risen, rise_names, rank, slots, columns = deformations[m]
-        back, back_names, next_rank, next_slots, next_columns = deformations[m + 1]
+        risen, rise_names, rank, columns = deformations[m]
+        back, back_names, next_rank, next_columns = deformations[m + 1]
         # Lane 0 is the staging height itself: its robots need no lift.
-        lift = shared_lanes(rank, next_rank) * layout.pitch
-        heights.update((layout.top + lift).tolist())
+        lanes = shared_lanes(rank, next_rank)
+        top = staging_height(layout, offsets[m:m + 2], int(lanes.max()))
+        lift = lanes * layout.pitch
+        heights.update((top + lift).tolist())
+        # A slot is its column at the staging height, other coordinates (d >= 3) kept.
+        slots, next_slots = (
+            ends_of + (top - layout.frame.offset(ends_of))[:, None] * e2
+            for ends_of in (columns, next_columns))
         stages += [*risen[1:], columns, slots + lift[:, None] * e2,
                    next_slots + lift[:, None] * e2, next_columns, back[-1], *back[-2::-1]]
         names += [*rise_names, GATHER, LIFT, SLIDE, DROP, GATHER + '^-1',
