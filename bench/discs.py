@@ -108,11 +108,6 @@ def condition_fleet(k, n, seed):
     return None
 
 
-def straight_length(configurations):
-    """Return the summed robot travel of straight lines through C_1..C_n."""
-    return float(np.linalg.norm(np.diff(configurations, axis=0), axis=2).sum())
-
-
 @dataclass
 class Result:
     """One planner on one fleet: the certified gap, path-length ratio and time."""
@@ -149,8 +144,8 @@ def run_ours(fleet, variant, repeats=3):
         gap = result.min_gap
         best = min(best, time.perf_counter() - begin)
         build = min(build, built - begin)
-    travel = float(np.linalg.norm(np.diff(result.positions, axis=0), axis=2).sum())
-    return Result(variant, fleet, gap, travel / straight_length(fleet.configurations), best,
+    return Result(variant, fleet, gap,
+                  peers.length_ratio(result.positions, fleet.configurations), best,
                   result.domain_index, result.clearance.resolution, build)
 
 
@@ -165,9 +160,8 @@ def run_rrt(fleet, budget):
         return Result(RRT, fleet, -np.inf, np.nan, seconds)
     radii = np.concatenate([np.full(fleet.k, RADIUS), fleet.radii])
     certificate = certify(np.linspace(0, 1, len(raw)), raw, fleet.pillars, radii)
-    travel = float(np.linalg.norm(np.diff(raw, axis=0), axis=2).sum())
     return Result(RRT, fleet, certificate.distance,
-                  travel / straight_length(fleet.configurations), seconds,
+                  peers.length_ratio(raw, fleet.configurations), seconds,
                   resolution=certificate.resolution)
 
 

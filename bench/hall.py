@@ -22,8 +22,9 @@ import time
 
 from core_speed import grid_main, grid_report
 import numpy as np
+from peers import length_ratio
 from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
-from refinement import each_fleet, PILLAR, RADIUS, straight_length
+from refinement import each_fleet, PILLAR, RADIUS
 
 MARGIN = 0.15
 # Seeds of the hidden fleets: far from bench/refinement.py's 100 k + 10 d + seed.
@@ -67,8 +68,7 @@ def _length_ratio(fleet, frame=None) -> float:
     workspace = Workspace(fleet.pillars, variant='discs', robot_radius=RADIUS,
                           obstacle_radius=PILLAR, frame=frame)
     result = plan(workspace, fleet.configurations, certify=False)
-    travel = float(np.linalg.norm(np.diff(result.positions, axis=0), axis=2).sum())
-    return travel / straight_length(fleet.configurations)
+    return length_ratio(result.positions, fleet.configurations)
 
 
 def run_one(fleet) -> Outcome:

@@ -154,6 +154,11 @@ def motion_length(positions):
     return float(np.sqrt(np.einsum('vkd,vkd->vk', steps, steps)).sum())
 
 
+def length_ratio(positions, configurations):
+    """Return a motion's length over the straight-line bound: the same sum for C_1..C_n."""
+    return motion_length(positions) / motion_length(configurations)
+
+
 def perturbed(query, rng):
     """
     Return the query moved by at most PERTURBATION inside the same domain.
@@ -180,8 +185,7 @@ def _finish(outcome):
     if outcome.positions is not None:
         outcome.certificate = certify(outcome.times, outcome.positions, query.obstacles)
         outcome.clearance = outcome.certificate.distance
-        outcome.length_ratio = (motion_length(outcome.positions)
-                                / motion_length(query.configurations))
+        outcome.length_ratio = length_ratio(outcome.positions, query.configurations)
     return outcome
 
 

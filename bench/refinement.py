@@ -95,11 +95,6 @@ def each_fleet(ks, seeds, seed_of, progress=None):
             yield fleet
 
 
-def straight_length(configurations):
-    """Return the straight-line bound: the summed robot distances C_m -> C_{m+1}."""
-    return float(np.linalg.norm(np.diff(configurations, axis=0), axis=2).sum())
-
-
 def excursion(positions, fleet):
     """Return how far positions (V, k, d) leave the box of configurations and pillars."""
     d = fleet.d
@@ -154,9 +149,8 @@ def run_ours(fleet, refine, measure_continuity, repeats=2):
         result = plan(workspace, fleet.configurations, certify=False, refine=refine)
         gap = result.min_gap
         best = min(best, time.perf_counter() - begin)
-    travel = float(np.linalg.norm(np.diff(result.positions, axis=0), axis=2).sum())
     return Result(REFINED if refine else RAW, fleet, True,
-                  travel / straight_length(fleet.configurations),
+                  peers.length_ratio(result.positions, fleet.configurations),
                   excursion(result.positions, fleet), gap,
                   result.margin if refine else gap, best,
                   continuity=_continuity(fleet, refine, result) if measure_continuity
@@ -178,8 +172,7 @@ def run_rrt(fleet, budget, simplify_budget):
         return Result(RRT, fleet, False, seconds=total, checker_seconds=checking)
     radii = np.concatenate([np.full(fleet.k, RADIUS), np.full(len(fleet.pillars), PILLAR)])
     gap = certify(np.linspace(0, 1, len(short)), short, fleet.pillars, radii).distance
-    travel = float(np.linalg.norm(np.diff(short, axis=0), axis=2).sum())
-    return Result(RRT, fleet, True, travel / straight_length(fleet.configurations),
+    return Result(RRT, fleet, True, peers.length_ratio(short, fleet.configurations),
                   excursion(short, fleet), gap, 0.0, total, checking)
 
 

@@ -36,10 +36,11 @@ from dataclasses import dataclass
 
 from core_speed import grid_main, grid_report
 import numpy as np
+from peers import length_ratio, motion_length
 from punctured_planner.core import plan, Workspace
 from punctured_planner.core import refine as refinement_stage
 from punctured_planner.core.certificate import certify
-from refinement import each_fleet, excursion, PILLAR, RADIUS, straight_length
+from refinement import each_fleet, excursion, PILLAR, RADIUS
 from scipy.optimize import linprog, minimize
 
 # Enough blocks for the caps' fixed point: 100 and 400 give the same medians to 0.01.
@@ -112,9 +113,9 @@ def _pillar_angles(positions, pillars):
     return swept_angles(positions[:, :, None, :] - pillars[None, None])
 
 
-def _pair_angles(positions):
-    """Return the angles (k, k) each robot sweeps around each other robot."""
-    return swept_angles(positions[:, :, None, :] - positions[:, None, :, :])
+def _pair_angles(positions, first, second):
+    """Return the angles robots first sweep around robots second (pairs,) over positions."""
+    return swept_angles(positions[:, first] - positions[:, second])
 
 
 def segment_floor(positions: np.ndarray, pillars: np.ndarray, margin: float) -> float:
@@ -130,7 +131,7 @@ def segment_floor(positions: np.ndarray, pillars: np.ndarray, margin: float) -> 
     if not len(first):
         return float(alone.sum())
     pairs = around_disc(start[first] - start[second], end[first] - end[second],
-                        _pair_angles(positions)[first, second], 2 * RADIUS + margin)
+                        _pair_angles(positions, first, second), 2 * RADIUS + margin)
     rows = np.zeros((len(first), k))
     rows[np.arange(len(first)), first] = rows[np.arange(len(first)), second] = -1.0
     result = linprog(np.ones(k), A_ub=rows, b_ub=-pairs,
@@ -139,19 +140,20 @@ def segment_floor(positions: np.ndarray, pillars: np.ndarray, margin: float) -> 
     return float(result.fun)
 
 
-def floor_ratio(motion, pillars: np.ndarray, margin: float, straight: float) -> float:
+def floor_ratio(motion, pillars: np.ndarray, margin: float) -> float:
     """Return the floor of a plan's topology over its straight-line bound."""
     indices = motion.waypoint_indices
     return sum(segment_floor(motion.positions[a:b + 1], pillars, margin)
-               for a, b in zip(indices[:-1], indices[1:])) / straight
+               for a, b in zip(indices[:-1], indices[1:])) / motion_length(motion.configurations)
 
 
 def _topology(motion, pillars):
     """Return every swept angle of a plan, segment by segment (its topology)."""
     indices = motion.waypoint_indices
+    first, second = np.triu_indices(motion.positions.shape[1], 1)
     return np.concatenate([
         np.concatenate([_pillar_angles(motion.positions[a:b + 1], pillars).ravel(),
-                        _pair_angles(motion.positions[a:b + 1]).ravel()])
+                        _pair_angles(motion.positions[a:b + 1], first, second)])
         for a, b in zip(indices[:-1], indices[1:])])
 
 
@@ -230,11 +232,6 @@ def _blocks(count):
         refinement_stage.BLOCKS = kept
 
 
-def _length(motion) -> float:
-    """Return the summed path length of every robot."""
-    return float(np.linalg.norm(np.diff(motion.positions, axis=0), axis=2).sum())
-
-
 def run_one(fleet) -> Outcome:
     """Plan one fleet three ways, optimise it locally and bound its topology."""
     workspace = Workspace(fleet.pillars, variant='discs', robot_radius=RADIUS,
@@ -252,11 +249,10 @@ def run_one(fleet) -> Outcome:
     samples = np.linspace(0.0, 1.0, len(optimum.positions))
     shortfall = refined.margin - certify(samples, optimum.positions, fleet.pillars,
                                          radii).distance
-    straight = straight_length(fleet.configurations)
-    outcome = Outcome(fleet.k, _length(raw) / straight, _length(refined) / straight,
-                      _length(fixed) / straight, _length(optimum) / straight,
-                      max(shortfall, 0.0),
-                      floor_ratio(raw, fleet.pillars, refined.margin, straight),
+    ratios = (length_ratio(motion.positions, fleet.configurations)
+              for motion in (raw, refined, fixed, optimum))
+    outcome = Outcome(fleet.k, *ratios, max(shortfall, 0.0),
+                      floor_ratio(raw, fleet.pillars, refined.margin),
                       excursion(refined.positions, fleet), excursion(optimum.positions, fleet))
     # A floor above a motion of that topology would be no floor.
     assert outcome.floor <= min(outcome.refined, outcome.fixed_point, outcome.optimum), outcome
