@@ -223,8 +223,8 @@ def test_the_rise_ends_every_robot_at_its_compressed_height_unpushed(count):
     assert np.all(np.diff(motion.lift, axis=0) >= 0)  # no robot ever moves down
     if beta == 1.0:  # the fleet rises as one: the rise adds no breakpoint per robot
         assert np.all(motion.lift == motion.lift[:, :1])
-    else:  # the robot far above top does not move, the lowest rises to top exactly
-        assert np.all(motion.lift[:, 0] == 0) and h[-1] + motion.lift[-1, -1] == layout.top
+    else:  # the robot far above top does not move (the lowest rises to top: expected above)
+        assert np.all(motion.lift[:, 0] == 0)
 
 
 @settings(max_examples=40, deadline=None)

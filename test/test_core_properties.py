@@ -4,7 +4,7 @@ from functools import partial
 
 from core_inputs import axis_obstacles, configuration_with_count
 from core_strategies import requests
-from hypothesis import given, HealthCheck, settings
+from hypothesis import assume, given, HealthCheck, settings
 from hypothesis import strategies as st
 import numpy as np
 from punctured_planner.core import plan, Workspace
@@ -152,3 +152,29 @@ def test_every_domain_value_is_hit(r, k, n, d):
         assert p.projection_counts.tolist() == targets.tolist()
         hit.add(p.domain)
     assert hit == set(range(low, high + 1))
+
+
+@PROPERTY
+@given(requests(), VARIANTS, st.booleans(),
+       st.lists(st.integers(-1000, 1000), min_size=4, max_size=4))
+def test_a_translated_request_gets_the_motion_translated(request, variant, refine, shift):
+    """
+    Moving obstacles and robots by v moves the motion by v: the axis follows the obstacles.
+
+    With the frame's origin at 0, obstacles and robots near y = 100 made every robot
+    travel to y = 0 and back (doc/design.md section 4). v is whole, so the moved input
+    is exact; the frame is an axis frame, whose projections v moves exactly too.
+    """
+    obstacles, configurations, _ = request
+    d = obstacles.shape[1]
+    assume(len(obstacles) > 0)  # without them nothing fixes the axis: it stays through 0
+    v = np.array(shift[:d], dtype=float)
+    moved = Workspace(obstacles + v, variant=variant)
+    # Not a moment-curve frame: moving one could make equal projections unequal.
+    assume(np.count_nonzero(moved.frame.e1) == 1)
+    p = plan(Workspace(obstacles, variant=variant), configurations, refine=refine)
+    q = plan(moved, configurations + v, refine=refine)
+    assert q.domain_index == p.domain_index
+    assert np.array_equal(q.times, p.times)
+    scale = 1.0 + np.abs(p.positions).max()
+    assert np.allclose(q.positions - v, p.positions, rtol=0, atol=1e-9 * scale * 1000)

@@ -50,7 +50,8 @@ def test_lanes_start_one_spacing_beyond_the_obstacles():
     """Spread lanes: lane_spacing apart, the first lane_spacing above the highest obstacle."""
     ws = Workspace([[0.0, 2.0], [1.0, -1.0]], variant='spread', lane_spacing=0.75)
     p = base(ws, [[[0.5, 0.5], [2.0, 0.0]], [[3.0, 1.0], [-1.0, 1.0]]])
-    assert np.allclose(p.lanes, [2.75, 3.5])
+    # The lanes are e2 offsets from the axis; at y = 2 + 0.75 and 2 + 1.5 in the plane.
+    assert np.allclose(p.lane_segments()[:, :, 1], [[2.75, 2.75], [3.5, 3.5]])
 
 
 @PROPERTY

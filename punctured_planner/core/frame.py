@@ -84,21 +84,40 @@ def _room(obstacles, bounds, b, sign):
     return float(wall - (sign * obstacles[:, b]).max())
 
 
+def _origin(obstacles, bounds, e1):
+    """
+    Return o: the obstacles' centroid (else the walls' centre, else 0) less its e1 part.
+
+    The point variants carry every robot to the axis o + R e1 and the discs variant
+    centres nothing on it, so the axis goes through the middle of the workspace: with
+    o = 0, obstacles and robots near y = 100 made every robot travel to y = 0 and back.
+    Dropping the e1 part leaves every projection p(x) = <x - o, e1> as it was (exactly,
+    for an axis frame, whose o has a 0 in e1's coordinate).
+    """
+    if len(obstacles):
+        centre = obstacles.mean(axis=0)
+    elif bounds is not None:
+        centre = bounds.mean(axis=1)
+    else:
+        return np.zeros_like(e1)
+    return centre - (centre @ e1) * e1
+
+
 def choose_frame(obstacles: np.ndarray, bounds: np.ndarray | None = None) -> Frame:
     """
     Return the default frame for obstacles (r, d): deterministic, fixed per workspace.
 
-    The coordinate axes (o = 0, e1 = x, e2 = y) whenever the obstacles' x
-    coordinates are distinct; otherwise the next coordinate axis that works;
-    otherwise the moment-curve direction that maximises the smallest gap between
-    obstacle projections. With walls (bounds (d, 2)) and obstacles, the axis
-    frame (e1 a coordinate axis that separates them, e2 another one either way)
-    with the most room between the wall e2 points to and the farthest obstacle
-    along e2, where the construction stages and runs its lanes (the first of
-    _axis_frames on a tie; doc/design.md section 17).
+    The origin o is the obstacles' centroid (else the walls' centre, else 0) less its e1
+    part (_origin). The directions are the coordinate axes (e1 = x, e2 = y) whenever the
+    obstacles' x coordinates are distinct; otherwise the next coordinate axis that
+    works; otherwise the moment-curve direction that maximises the smallest gap between
+    obstacle projections. With walls (bounds (d, 2)) and obstacles, the axis frame (e1 a
+    coordinate axis that separates them, e2 another one either way) with the most room
+    between the wall e2 points to and the farthest obstacle along e2, where the
+    construction stages and runs its lanes (the first of _axis_frames on a tie;
+    doc/design.md section 17).
     """
     r, d = obstacles.shape
-    origin = np.zeros(d)
     separating = [a for a in range(d)
                   if r < 2 or np.all(np.diff(np.sort(obstacles[:, a])) > 0)]
     frames = [(a, b, sign) for a, b, sign in _axis_frames(d) if a in separating]
@@ -110,12 +129,12 @@ def choose_frame(obstacles: np.ndarray, bounds: np.ndarray | None = None) -> Fra
             a, b, sign = frames[0]
         e1, e2 = np.zeros(d), np.zeros(d)
         e1[a], e2[b] = 1.0, sign
-        return Frame(origin, e1, e2)
+        return Frame(_origin(obstacles, bounds, e1), e1, e2)
     count = max(16, (r * (r - 1) // 2) * (d - 1) + 1)
     directions = _moment_curve_directions(d, count)
     gaps = np.diff(np.sort(obstacles @ directions.T, axis=0), axis=0).min(axis=0)
     e1 = directions[int(np.argmax(gaps))]
-    return Frame(origin, e1, _complement_direction(e1))
+    return Frame(_origin(obstacles, bounds, e1), e1, _complement_direction(e1))
 
 
 def checked_frame(frame: Frame | tuple, dimension: int) -> Frame:
