@@ -14,7 +14,7 @@ from core_strategies import lattice_requests, requests, separation
 from hypothesis import assume, given, HealthCheck, settings, strategies as st
 import numpy as np
 from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
-from punctured_planner.core.discs import COMPRESSED_ROBOTS, COMPRESSION, MARGIN, rise
+from punctured_planner.core.discs import MARGIN, rise, stacked_heights, STACKED_ROBOTS
 import pytest
 
 PROPERTY = settings(max_examples=120, deadline=None,
@@ -206,25 +206,73 @@ def test_bad_radii_are_refused(options, words):
     assert words in str(caught.value)
 
 
-@pytest.mark.parametrize('count', [9, COMPRESSED_ROBOTS, COMPRESSED_ROBOTS + 1])
-def test_the_rise_ends_every_robot_at_its_compressed_height_unpushed(count):
-    """F(h) = max(h, top + beta (h - h_min)), beta = 1 beyond COMPRESSED_ROBOTS robots."""
+def spread_fleet(rng, count, apart, low, high):
+    """Return (count, 2) points uniform in [low, high]^2, pairwise >= apart (or None)."""
+    points = np.zeros((0, 2))
+    for _ in range(20000):
+        point = rng.uniform(low, high, 2)
+        if np.all(np.linalg.norm(points - point, axis=1) >= apart):
+            points = np.vstack([points, point])
+            if len(points) == count:
+                return points
+    return None
+
+
+@pytest.mark.parametrize('count', [9, STACKED_ROBOTS, STACKED_ROBOTS + 1])
+def test_the_rise_stacks_the_fleet_on_the_staging_height_unpushed(count):
+    """
+    The risen fleet: above top, 2R + nu apart, stacked D_p - |dp| above every robot below.
+
+    Beyond STACKED_ROBOTS the fleet rises as one, by top - h_min: a single stop.
+    """
     pillars = np.array([[0.0, 0.0], [2.5, 1.0], [5.0, -0.5]])
-    layout = Workspace(pillars, variant='discs', robot_radius=0.2,
-                       obstacle_radius=0.15).disc_layout
-    p = np.linspace(-1.0, 6.0, count)
-    h = np.random.default_rng(count).uniform(-4.0, 6.0, count)
-    h[0], h[-1] = layout.top + 15.0, -4.0  # one robot far above top, one below all
+    workspace = Workspace(pillars, variant='discs', robot_radius=0.2, obstacle_radius=0.15)
+    layout = workspace.disc_layout
+    rng = np.random.default_rng(count)
+    side = 1.2 * np.sqrt(count)  # robots cover about a tenth of the square
+    fleet = spread_fleet(rng, count, separation(workspace), -side / 2, side / 2)
+    fleet[0] = [-side, layout.top + 15.0]  # one robot far above top
+    p, h = layout.frame.project(fleet), layout.frame.offset(fleet)
     motion = rise(p, h, layout)
-    beta = COMPRESSION if count <= COMPRESSED_ROBOTS else 1.0
-    expected = np.maximum(h, layout.top + beta * (h - h.min()))
-    assert np.allclose(h + motion.lift[-1], expected, rtol=0, atol=1e-12)
+    ends = h + motion.lift[-1]
     assert np.all(motion.shift[-1] == 0)
     assert np.all(np.diff(motion.lift, axis=0) >= 0)  # no robot ever moves down
-    if beta == 1.0:  # the fleet rises as one: the rise adds no breakpoint per robot
+    assert np.all(ends >= layout.top - 1e-12)  # h + (G - h) is G up to rounding
+    if count > STACKED_ROBOTS:  # the fleet rises as one: no breakpoint per robot
         assert np.all(motion.lift == motion.lift[:, :1])
-    else:  # the robot far above top does not move (the lowest rises to top: expected above)
-        assert np.all(motion.lift[:, 0] == 0)
+        return
+    assert motion.lift[-1, 0] == 0  # the robot far above does not move
+    assert np.allclose(ends, stacked_heights(p, h, layout), rtol=0, atol=1e-12)
+    dp = np.abs(p[:, None] - p[None, :])
+    # Within sqrt 2 (2R + nu) condition (a) puts the higher robot the whole fade above.
+    below = (h[None, :] < h[:, None]) & (dp < np.sqrt(2) * 2.1 * 0.2)
+    assert below.any()  # the fleet is dense enough to stack
+    rows, columns = np.nonzero(below)
+    assert np.all(ends[rows] - ends[columns]
+                  >= layout.pile_reach - dp[rows, columns] - 1e-12)
+    risen = np.stack([p, ends], axis=1)
+    a, b = np.triu_indices(count, 1)
+    assert np.linalg.norm(risen[a] - risen[b], axis=1).min() >= 2.1 * 0.2 - 1e-12
+    # Lower than the compressed rise it replaces, top + 0.55 (h - h_min), on the whole.
+    assert ends[1:].mean() < (layout.top + 0.55 * (h[1:] - h[1:].min())).mean()
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(2, 12), st.integers(0, 2 ** 16), st.floats(1e-9, 1e-6))
+def test_the_stacked_heights_move_little_with_the_input(count, seed, size):
+    """G is continuous: a small move of every robot moves every G by a bounded multiple."""
+    pillars = np.array([[0.0, 0.0], [2.5, 1.0]])
+    workspace = Workspace(pillars, variant='discs', robot_radius=0.2, obstacle_radius=0.15)
+    layout = workspace.disc_layout
+    rng = np.random.default_rng(seed)
+    fleet = spread_fleet(rng, count, separation(workspace), -2.0, 2.0)
+    assume(fleet is not None)
+    p, h = layout.frame.project(fleet), layout.frame.offset(fleet)
+    moved_p = p + rng.uniform(-size, size, count)
+    moved_h = h + rng.uniform(-size, size, count)
+    change = np.abs(stacked_heights(moved_p, moved_h, layout)
+                    - stacked_heights(p, h, layout)).max()
+    assert change <= 100 * count * size
 
 
 @settings(max_examples=40, deadline=None)

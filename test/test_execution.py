@@ -199,7 +199,7 @@ def demo_plan():
     """
     Return (Reference, Bodies, min gap) of the demo's plan: four discs, 1 m/s, 1 m/s^2.
 
-    The discs construction's compressed rise: many legs of about 0.2 m, shorter than
+    The discs construction's rise (a stop per robot): many legs of about 0.2 m, shorter than
     the 0.5 m a robot brakes in from 1 m/s, with corners between them.
     """
     from planner_helpers import CONFIGURATIONS

@@ -18,11 +18,13 @@ The construction keeps the paper's skeleton, H(C_m), Gamma, H(C_{m+1})^-1
 (Remark 2.3), with a new deformation H onto a new kind of base configuration:
 
 * sidestep and rise: robot i rises along e2 by min(s, s_i), s from 0 to
-  T = max_i s_i, with its stop s_i = max(0, top + beta (h_i - h_min) - h_i),
-  top = max_j (h(q_j) + z_j), h_min = min_i h(x_i) and the compression
-  beta = (1 + MARGIN) / 2 (1 beyond COMPRESSED_ROBOTS robots): it ends at
-  F(h_i) = max(h_i, top + beta (h_i - h_min)), above every zone, so a robot
-  high up rises little. Meanwhile each robot in
+  T = max_i s_i, with its stop s_i = G_i - h_i: G stacks the fleet on the
+  staging height top = max_j (h(q_j) + max(z_j, rho_j + g - R)) (above every
+  zone, and the slots' gap g - 2R above every pillar) by stacked_heights, so
+  every robot ends above every zone, a robot high up rises little, and a robot
+  ends D_p - |dp| above each robot below it within D_p = sqrt 2 g along e1,
+  wherever the weight allows and always within E = sqrt 2 (2R + nu) (beyond
+  STACKED_ROBOTS robots every stop is top - h_min). Meanwhile each robot in
   the shadow of pillar j (|p(x) - p(q_j)| < w_j) is pushed along e1, away from
   p(q_j) on its own side (a robot whose projection equals p(q_j) counts as
   right of it, as the paper's numbering puts robots after obstacles), by
@@ -36,7 +38,7 @@ The construction keeps the paper's skeleton, H(C_m), Gamma, H(C_{m+1})^-1
   breakpoints of all robots together describe the motion exactly. A push
   already due at s = 0 is made first, along e1 only (the sidestep leg). At
   s = T every robot is above every zone, unpushed: the fleet is C with every
-  h_i replaced by F(h_i).
+  h_i replaced by G_i.
 * gather: every robot moves along e1 only, at its risen height, into the
   column of slot rank(x) (the hyperplane p = that slot); slots
   g = max(min_spacing, 2R + nu) apart along e1, centred on the mean robot
@@ -56,7 +58,8 @@ The construction keeps the paper's skeleton, H(C_m), Gamma, H(C_{m+1})^-1
 
 Continuity and domains. On a stratum A_i the order of all k + r projections,
 ties included, is locally constant, so the side of every push and the ranks
-are; the stops and F (continuous in h), the pushes (continuous in p, h and
+are; the stops and G (continuous in p and h: where two robots' heights meet,
+the weight of one in the other's stacking term is 0), the pushes (continuous in p, h and
 zero at the shadow's edge), the slot centre and every breakpoint move
 continuously. The motion is therefore continuous on every A_{j_1} x ... x
 A_{j_n}, hence on every domain of the paper, whose projection counts, domains
@@ -76,10 +79,11 @@ robot-pillar gap of the configurations themselves (a robot touching a pillar
 in C_m keeps that gap there), a margin far above the rounding of the
 coordinates unless the input itself touches.
 
-Proof. F(y) - F(x) lies in [beta (y - x), y - x] for x <= y (a maximum of
-functions of slopes 1 and beta), and a higher robot stops no later, so
-during the rise the e2 difference of two robots keeps its sign and at least
-beta of its size. Every leg is one of the following.
+Proof. For robots a, b with h_a <= h_b let x = |p(x_a) - p(x_b)| and
+y = h_b - h_a. While both rise their e2 difference stays y, then it moves
+monotonically to G_b - G_a. Under (a), x < E forces y >= pile_fade, so
+(*) G_b >= G_a + E - x >= top + E - x whenever x < E. Every leg is one
+of the following.
 (1) Sidestep and rise, robot and pillar j. Each robot follows the path of a
 common rise, cut off at its stop above every zone. While |u| > w_j the e2
 distance exceeds w_j. While |u| <= w_j, the push of j alone puts the robot at
@@ -104,24 +108,21 @@ in e1. Otherwise at most one moves towards the other, by at most
 w_max = max_j w_j in e1, and (|dp| - w_max)^2 + dh^2 = S^2 - 2 w_max
 sqrt(S^2 - dh^2) + w_max^2 grows with dh, so it is at least
 (S - w_max)^2 >= (2R + nu)^2 whenever |dp|^2 + dh^2 >= S^2. (ii) While
-neither is pushed, only their e2 difference has changed, by the factor
-above: they are >= beta S = 2R + 2 nu apart. (iii) Otherwise one, a, is
-pushed by some j (so it still rises, below top) and b has stopped: then
-h_b > h_a, b is at F(h_b) >= top + beta (h_b - h_min) and a at
-eps = z_j - u <= top - h(a) below top, so their e2 distance is at least
-beta y + eps, y = h_b - h_a; a's push is lambda_j (w_j - delta) <=
-min(w_j, z_j - |u|) <= eps (z_j - f_j = w_j), so their distance across e2
-is at least x - eps, x = that distance in C. With x^2 + y^2 = rho^2 >= S^2
-the distance is at least the minimum over eps >= 0 of
-sqrt((x - eps)_+^2 + (beta y + eps)^2), which is (x + beta y) / sqrt 2 when
-x >= beta y and sqrt(x^2 + beta^2 y^2) >= beta rho otherwise; along the arc
-x + beta y is smallest at its ends, so the pair stays at least
-min(S / sqrt 2, beta S) >= 2R + 2 nu apart.
-(3) Gather. It starts from the risen fleet, pairwise >= beta S >= 2R + nu
-apart, and moves along e1 only to columns g apart in projection order. For
-robots a, b with rank a < rank b the e1 difference moves linearly from its
-start (>= 0) to a multiple of g, so at every instant it is at least the
-smaller of its start and g, while the other coordinates stay: the pair keeps
+neither is pushed, their e1 distance is x and their e2 difference lies
+between y and G_b - G_a: if x >= E they are E apart, otherwise by (*) at
+least min(S, sqrt(x^2 + (E - x)^2)) >= E / sqrt 2 = 2R + nu. (iii)
+Otherwise one is pushed by some j (so it still rises, below top) and the
+other has stopped at or above top: the stopped one is b, the higher. a is
+eps = z_j - u <= top - h(a) below top and its push is lambda_j (w_j - delta)
+<= min(w_j, z_j - |u|) <= eps (z_j - f_j = w_j), so their e1 distance is at
+least x - eps, and by (*) b is at least c = (E - x)_+ above top, so their
+e2 distance is at least eps + c. Over eps >= 0, (x - eps)_+^2 + (eps + c)^2
+>= (x + c)^2 / 2 and x + c >= E: they stay 2R + nu apart.
+(3) Gather. It starts from the risen fleet, pairwise >= 2R + nu apart (by
+(*), as in (ii)), and moves along e1 only to columns g apart in projection
+order. For robots a, b with rank a < rank b the e1 difference moves linearly
+from its start (>= 0) to a multiple of g, so at every instant it is at least
+the smaller of its start and g, while the other coordinates stay: the pair keeps
 at least the smaller of its start distance and g >= 2R + nu. All of it lies
 in h >= top, where every robot is at least z_j >= w_j from every pillar.
 (4) Gamma. Each robot moves within its column (the hyperplane p = its slot,
@@ -152,15 +153,16 @@ FULL, ZONE = np.sqrt(2.0) - 1.0, np.sqrt(2.0)
 # The body margins as fractions: mu_j = MARGIN max(R, rho_j) past pillar j, nu = MARGIN R
 # between two robots (module docstring). Every body gap of the plan keeps one of them.
 MARGIN = 0.1
-# The rise's compression beta: robot i stops at F(h_i) = max(h_i, top + beta (h_i - h_min)),
-# so two robots S = 4R apart end >= beta S = 2R + 2 nu apart: one nu more than the gather
-# needs (module docstring). Smaller beta rises less; (2R + nu) / 4R = 0.525 is the least
-# it may be.
-COMPRESSION = (1.0 + MARGIN) / 2
+# The rise stacks the fleet on the staging height (stacked_heights): a robot ends at least
+# D_p - |dp| above every robot below it whose projection is within D_p = sqrt 2 g of its
+# own (DiscLayout.pile_reach), which keeps the risen fleet apart and a robot pushed past a
+# pillar below off it (module docstring). Beyond D_p that least height falls at
+# PILE_SLOPE per metre of |dp|, so a tall stack reaches only a little farther along e1.
+PILE_SLOPE = 4.0
 # Every stop is a breakpoint of the whole motion: k more per rise. Beyond this many robots
-# (k is constant on a domain) the fleet rises as one (beta = 1, a single stop), which keeps
-# a plan of 200 robots within its time budget (doc/design.md section 6).
-COMPRESSED_ROBOTS = 64
+# (k is constant on a domain) the fleet rises as one (by top - h_min, a single stop), which
+# keeps a plan of 200 robots within its time budget (doc/design.md section 6).
+STACKED_ROBOTS = 64
 
 SIDESTEP, RISE, GATHER = 'sidestep', 'rise', 'gather'
 LIFT, SLIDE, DROP = 'lift', 'slide', 'drop'
@@ -172,8 +174,9 @@ class DiscLayout:
     What the construction fixes per workspace: the pillars in frame coordinates and pitches.
 
     reach w_j, full-push and zone half-heights f_j, z_j per pillar, the staging
-    height top (0, the axis, without pillars) and the pitch g of the slots and
-    the lanes (module docstring).
+    height top (with pillars; without, each segment's staging_height), the pitch
+    g of the slots and the lanes, and the stack's reach D_p and fade
+    (stacked_heights; module docstring).
     """
 
     frame: Frame
@@ -184,6 +187,8 @@ class DiscLayout:
     zone: np.ndarray
     top: float
     pitch: float
+    pile_reach: float
+    pile_fade: float
 
     @classmethod
     def from_radii(cls, frame: Frame, obstacles: np.ndarray, robot_radius: float,
@@ -196,9 +201,18 @@ class DiscLayout:
         reach = robot_radius + obstacle_radius + margin
         reach = np.where(reach > 0, reach, 0.5 * min_spacing)
         offsets = frame.offset(obstacles)
-        top = float((offsets + ZONE * reach).max()) if len(obstacles) else 0.0
+        apart = (2.0 + MARGIN) * robot_radius
+        pitch = max(min_spacing, apart)
+        # Above every zone, and as far above every pillar as the slots keep robots apart:
+        # a robot staged there passes each pillar with at least the slots' gap g - 2R.
+        clear = np.maximum(ZONE * reach, obstacle_radius + pitch - robot_radius)
+        top = float((offsets + clear).max()) if len(obstacles) else 0.0
+        separation = max(4.0 * robot_radius, apart + float(reach.max(initial=0.0)))
+        # The stack keeps the slots' pitch where it can; the fade is what condition (a)
+        # allows for the least it must keep, sqrt 2 (2R + nu) (module docstring).
+        fade = np.sqrt(max(separation ** 2 - 2.0 * apart ** 2, 0.0))
         return cls(frame, frame.project(obstacles), offsets, reach, FULL * reach, ZONE * reach,
-                   top, max(min_spacing, (2.0 + MARGIN) * robot_radius))
+                   top, pitch, np.sqrt(2.0) * pitch, float(fade))
 
     def conflicting_pillars(self, robot_radius: float) -> np.ndarray:
         """
@@ -236,21 +250,47 @@ def push_factor(relative_height: np.ndarray, full: np.ndarray, zone: np.ndarray)
     return np.clip((zone - np.abs(relative_height)) / (zone - full), 0.0, 1.0)
 
 
+def stacked_heights(p: np.ndarray, h: np.ndarray, layout: DiscLayout) -> np.ndarray:
+    """
+    Return the (k,) heights G the rise ends at: the fleet stacked on the staging height.
+
+    G_i = max(h_i, top, max_j top + (G_j + phi(|p_i - p_j|) - top)_+ w(h_i - h_j)), with
+    phi(x) = D_p - x up to D_p = pile_reach = sqrt 2 g and falling at PILE_SLOPE
+    beyond, and the weight w(y) = clip(y / pile_fade, 0, 1): 0 unless robot j is below
+    robot i. Robots are taken from the lowest up, so every G_j a weight reaches is
+    final. Under the theorem's condition (a) a robot within E = sqrt 2 (2R + nu) of j
+    along e1 is at least pile_fade above it, so it ends >= phi above G_j; the weight
+    lets the requirement fade out continuously as two robots' heights meet, where (a)
+    puts them farther than E apart along e1 (module docstring).
+    """
+    distance = np.abs(p[:, None] - p[None, :])
+    least = np.where(distance <= layout.pile_reach, layout.pile_reach - distance,
+                     PILE_SLOPE * (layout.pile_reach - distance))
+    # pile_fade >= S >= every pillar's reach > 0 wherever there is a pillar to rise past.
+    weight = np.clip((h[:, None] - h[None, :]) / layout.pile_fade, 0.0, 1.0)
+    heights = np.maximum(h, layout.top)
+    for robot in np.argsort(h, kind='stable').tolist():
+        above = np.maximum(heights + least[robot] - layout.top, 0.0) * weight[robot]
+        heights[robot] = max(heights[robot], layout.top + float(above.max()))
+    return heights
+
+
 def rise(p: np.ndarray, h: np.ndarray, layout: DiscLayout) -> Rise:
     """
     Return the sidestep and rise of a configuration with projections p and offsets h (k,).
 
-    Robot i rises by min(s, s_i), s_i = max(0, top + beta (h_i - h_min) - h_i)
-    its stop, for s from 0 to T = max_i s_i. The breakpoints are s = 0 (after
-    the sidestep), every stop, and every s in (0, T) where a robot in a pillar's
-    shadow crosses an edge of its zone (module docstring).
+    Robot i rises by min(s, s_i), s_i = G_i - h_i its stop (stacked_heights;
+    top - h_min for all beyond STACKED_ROBOTS robots), for s from 0 to
+    T = max_i s_i. The breakpoints are s = 0 (after the sidestep), every stop,
+    and every s in (0, T) where a robot in a pillar's shadow crosses an edge of
+    its zone (module docstring).
     """
     if layout.reach.size == 0:
         return Rise(np.zeros((1, len(p))), np.zeros((1, len(p))))
-    low = float(h.min())
-    compression = COMPRESSION if len(h) <= COMPRESSED_ROBOTS else 1.0
-    # (top - h_min) - (1 - beta) (h_i - h_min): with beta = 1 every stop is the same float.
-    stops = np.maximum(0.0, (layout.top - low) - (1.0 - compression) * (h - low))
+    if len(h) <= STACKED_ROBOTS:
+        stops = stacked_heights(p, h, layout) - h
+    else:  # one common stop, the same float for every robot: no breakpoint per robot
+        stops = np.full(len(h), max(0.0, layout.top - float(h.min())))
     total = float(stops.max())
     signed = p[:, None] - layout.pillar_projections[None, :]
     robots, pillars = np.nonzero(np.abs(signed) < layout.reach[None, :])
