@@ -28,12 +28,6 @@ class Gap:
     first: int = -1
     second: int = -1
 
-    def describe(self, names) -> str:
-        """Return 'robot_1 and robot_4' or 'robot_1 and obstacle 2' for robot names."""
-        if self.kind == 'robots':
-            return '%s and %s' % (names[self.first], names[self.second])
-        return '%s and obstacle %d' % (names[self.first], self.second)
-
 
 @dataclass(frozen=True)
 class Bodies:

@@ -30,13 +30,13 @@ from ..core import first_out_of_range
 from ..core import MAX_COORDINATE
 from ..core import PlanningError
 from ..core import SCHEDULES
+from ..core.errors import axis_name
 from ..core.errors import literal
 
 # Largest |z - plane_z| accepted in planar mode (m).
 PLANE_TOLERANCE = 1e-9
 # builtin_interfaces/Time holds int32 seconds: no stamp may reach 2^31 s.
 _LAST_STAMP_NS = (2 ** 31 - 1) * 1000000000
-_AXES = 'xyz'
 
 
 @dataclass(frozen=True, eq=False)
@@ -222,7 +222,7 @@ def _check_range(settings: PlannerSettings, points: np.ndarray, counts: list[int
     robot = row - (ends[m - 1] if m else 0)
     raise PlanningError(
         ErrorCode.INVALID_REQUEST, '{configuration}, robot %d: %s = %.6g is beyond '
-        'the supported range +-%.0e' % (robot, _AXES[axis], float(points[far]),
+        'the supported range +-%.0e' % (robot, axis_name(axis), float(points[far]),
                                         MAX_COORDINATE),
         configuration=m, robots=[robot], coordinate=axis)
 
@@ -232,9 +232,9 @@ def check_obstacle_range(settings: PlannerSettings, obstacles: ObstacleSet) -> N
     far = first_out_of_range(obstacles.points[:, :settings.dimension])
     if far is not None:
         j, axis = far
+        value = float(obstacles.points[far])
         raise PlanningError(ErrorCode.INVALID_REQUEST, '{obstacle}: %s = %.6g is beyond the '
-                            'supported range +-%.0e' % (_AXES[axis], float(obstacles.points[far]),
-                                                        MAX_COORDINATE),
+                            'supported range +-%.0e' % (axis_name(axis), value, MAX_COORDINATE),
                             obstacle=j, coordinate=axis)
 
 
@@ -268,7 +268,7 @@ def _check_non_finite(positions: np.ndarray) -> None:
     if bad is not None:
         m, robot, axis = bad
         raise PlanningError(ErrorCode.NON_FINITE_VALUE, '{configuration}, robot %d: %s is %r'
-                            % (robot, _AXES[axis], float(positions[bad])),
+                            % (robot, axis_name(axis), float(positions[bad])),
                             configuration=m, robots=[robot], coordinate=axis)
 
 
@@ -277,7 +277,7 @@ def check_obstacle_values(obstacles: ObstacleSet) -> None:
     bad = conversions.first_non_finite(obstacles.points)
     if bad is not None:
         raise PlanningError(ErrorCode.NON_FINITE_VALUE, '{obstacle}: %s is %r'
-                            % (_AXES[bad[1]], float(obstacles.points[bad])),
+                            % (axis_name(bad[1]), float(obstacles.points[bad])),
                             obstacle=bad[0], coordinate=bad[1])
 
 

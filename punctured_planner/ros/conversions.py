@@ -24,6 +24,13 @@ Conventions:
   pose in C_m; between C_m and C_{m+1} it holds the orientation of C_m (the
   last waypoint passed). A zero-length or non-finite input quaternion counts
   as the identity; others are normalised.
+* Messages built in bulk are *filled in place*: rosidl's generated classes keep
+  field f in slot ``_f`` (beside ``_check_fields``), and their constructor
+  builds a default for every nested message first; for the k x M poses of a
+  plan that churn was most of the time spent building the response. So those
+  builders create the object bare and set its slots, with values that already
+  have the field types (floats, messages); test_conversions compares the
+  results with constructed messages.
 """
 
 from dataclasses import dataclass
@@ -73,8 +80,8 @@ def pose_arrays_poses(messages):
 
     Every request's poses come through here, all its configurations in one array
     (one conversion, not one per configuration); the fields are read from their
-    slots (``_x`` for x, as :func:`_filled` writes them), half the time of their
-    properties.
+    slots (``_x`` for x, as the messages filled in place have them: module
+    docstring), half the time of their properties.
     """
     rows = []
     for msg in messages:
@@ -158,8 +165,8 @@ def time_from_ns(ns):
     """
     Return builtin_interfaces/Time for integer nanoseconds (>= 0).
 
-    Filled in place, as :func:`_filled` does but without its keyword loop: every
-    stamp of every path is one (Time's constructor costs five times as much).
+    Filled in place (module docstring): every stamp of every path is one
+    (Time's constructor costs five times as much).
     """
     stamp = object.__new__(Time)
     stamp._sec, stamp._nanosec = divmod(int(ns), 1000000000)
@@ -199,24 +206,6 @@ def stamps_ns(start_ns, seconds):
     offsets = np.rint(np.asarray(seconds) * 1e9).astype(np.int64)
     steps = np.arange(offsets.size, dtype=np.int64)
     return int(start_ns) + np.maximum.accumulate(offsets - steps) + steps
-
-
-def _filled(message_type, **fields):
-    """
-    Return a message of ``message_type`` with ``fields`` stored in its slots directly.
-
-    rosidl's generated classes keep field f in slot ``_f`` (beside
-    ``_check_fields``); their constructor builds a default for every nested
-    message first, and for the k x M poses of a plan that churn was most of the
-    time spent building the response. The values must already have the field
-    types (floats, messages); test_conversions compares the results with
-    constructed messages.
-    """
-    message = object.__new__(message_type)
-    message._check_fields = False
-    for name, value in fields.items():
-        setattr(message, '_' + name, value)
-    return message
 
 
 @dataclass(frozen=True)
@@ -263,9 +252,9 @@ def plan_to_paths(samples, orientations, frame_id, start_ns, plane_z=0.0):
     Built once, for the response and the topics alike: a :class:`Paths` of the
     messages (all paths share one Header object per stamp, and one as their own
     header, so their stamps are identical by construction, and each robot one
-    Quaternion per waypoint; each message is filled in place as by
-    :func:`_filled`, with no default sub-messages, its slots set one by one: a
-    keyword loop per pose cost as much as the rest) and the same values
+    Quaternion per waypoint; each message is filled in place (module
+    docstring), its slots set one by one: a keyword loop per pose cost as much
+    as the rest) and the same values
     serialised with numpy on first use.
     """
     xyz = to_xyz(samples.positions, plane_z).transpose(1, 0, 2)
@@ -315,7 +304,7 @@ def header(frame_id, stamp_ns):
 
 def point_list(xyz):
     """
-    Return geometry_msgs/Points of (N, 3) values, each filled in place (as :func:`_filled`).
+    Return geometry_msgs/Points of (N, 3) values, each filled in place (module docstring).
 
     The markers draw every breakpoint of every robot: Point's constructor, with
     its keyword handling and checks, cost most of their building.
