@@ -153,12 +153,6 @@ FULL, ZONE = np.sqrt(2.0) - 1.0, np.sqrt(2.0)
 # The body margins as fractions: mu_j = MARGIN max(R, rho_j) past pillar j, nu = MARGIN R
 # between two robots (module docstring). Every body gap of the plan keeps one of them.
 MARGIN = 0.1
-# The rise stacks the fleet on the staging height (stacked_heights): a robot ends at least
-# D_p - |dp| above every robot below it whose projection is within D_p = sqrt 2 g of its
-# own (DiscLayout.pile_reach), which keeps the risen fleet apart and a robot pushed past a
-# pillar below off it (module docstring). Beyond D_p that least height falls at
-# PILE_SLOPE per metre of |dp|, so a tall stack reaches only a little farther along e1.
-PILE_SLOPE = 4.0
 # Every stop is a breakpoint of the whole motion: k more per rise. Beyond this many robots
 # (k is constant on a domain) the fleet rises as one (by top - h_min, a single stop), which
 # keeps a plan of 200 robots within its time budget (doc/design.md section 6).
@@ -254,24 +248,27 @@ def stacked_heights(p: np.ndarray, h: np.ndarray, layout: DiscLayout) -> np.ndar
     """
     Return the (k,) heights G the rise ends at: the fleet stacked on the staging height.
 
-    G_i = max(h_i, top, max_j top + (G_j + phi(|p_i - p_j|) - top)_+ w(h_i - h_j)), with
-    phi(x) = D_p - x up to D_p = pile_reach = sqrt 2 g and falling at PILE_SLOPE
-    beyond, and the weight w(y) = clip(y / pile_fade, 0, 1): 0 unless robot j is below
-    robot i. Robots are taken from the lowest up, so every G_j a weight reaches is
-    final. Under the theorem's condition (a) a robot within E = sqrt 2 (2R + nu) of j
-    along e1 is at least pile_fade above it, so it ends >= phi above G_j; the weight
-    lets the requirement fade out continuously as two robots' heights meet, where (a)
-    puts them farther than E apart along e1 (module docstring).
+    G_i = max(h_i, top, max_j top + (G_j + D_p - |p_i - p_j| - top)_+ w(h_i - h_j)), with
+    D_p = pile_reach = sqrt 2 g and the weight w(y) = clip(y / pile_fade, 0, 1): 0 unless
+    robot j is below robot i, so the definition runs from the lowest robot up. Under the
+    theorem's condition (a) a robot within E = sqrt 2 (2R + nu) of j along e1 is at least
+    pile_fade above it, so it ends >= D_p - |dp| above G_j; the weight lets the
+    requirement fade out continuously as two robots' heights meet, where (a) puts them
+    farther than E apart along e1 (module docstring).
     """
-    distance = np.abs(p[:, None] - p[None, :])
-    least = np.where(distance <= layout.pile_reach, layout.pile_reach - distance,
-                     PILE_SLOPE * (layout.pile_reach - distance))
+    least = layout.pile_reach - np.abs(p[:, None] - p[None, :])
     # pile_fade >= S >= every pillar's reach > 0 wherever there is a pillar to rise past.
     weight = np.clip((h[:, None] - h[None, :]) / layout.pile_fade, 0.0, 1.0)
-    heights = np.maximum(h, layout.top)
-    for robot in np.argsort(h, kind='stable').tolist():
-        above = np.maximum(heights + least[robot] - layout.top, 0.0) * weight[robot]
-        heights[robot] = max(heights[robot], layout.top + float(above.max()))
+    floor = np.maximum(h, layout.top)
+    heights = floor
+    # Every pass settles the robots one level higher in the stack (each G_i depends only on
+    # robots below it), so at most k passes reach G, exactly as robot after robot would.
+    for _ in range(len(h)):
+        above = np.maximum(heights[None, :] + least - layout.top, 0.0) * weight
+        settled = np.maximum(floor, layout.top + above.max(axis=1))
+        if np.array_equal(settled, heights):
+            break
+        heights = settled
     return heights
 
 
