@@ -79,9 +79,10 @@ robot-pillar gap of the configurations themselves (a robot touching a pillar
 in C_m keeps that gap there), a margin far above the rounding of the
 coordinates unless the input itself touches.
 
-Proof. For robots a, b with h_a <= h_b let x = |p(x_a) - p(x_b)| and
-y = h_b - h_a. While both rise their e2 difference stays y, then it moves
-monotonically to G_b - G_a. Under (a), x < E forces y >= pile_fade, so
+Proof. For robots a, b with h_a <= h_b let x be their distance across e2 in
+C (the stack sees only |dp| <= x) and y = h_b - h_a. While both rise their e2
+difference stays y, then it moves monotonically to G_b - G_a. Under (a),
+x < E forces y >= pile_fade, so, as D_p - |dp| >= E - x,
 (*) G_b >= G_a + E - x >= top + E - x whenever x < E. Every leg is one
 of the following.
 (1) Sidestep and rise, robot and pillar j. Each robot follows the path of a
@@ -108,13 +109,13 @@ in e1. Otherwise at most one moves towards the other, by at most
 w_max = max_j w_j in e1, and (|dp| - w_max)^2 + dh^2 = S^2 - 2 w_max
 sqrt(S^2 - dh^2) + w_max^2 grows with dh, so it is at least
 (S - w_max)^2 >= (2R + nu)^2 whenever |dp|^2 + dh^2 >= S^2. (ii) While
-neither is pushed, their e1 distance is x and their e2 difference lies
+neither is pushed, their distance across e2 is x and their e2 difference lies
 between y and G_b - G_a: if x >= E they are E apart, otherwise by (*) at
 least min(S, sqrt(x^2 + (E - x)^2)) >= E / sqrt 2 = 2R + nu. (iii)
 Otherwise one is pushed by some j (so it still rises, below top) and the
 other has stopped at or above top: the stopped one is b, the higher. a is
 eps = z_j - u <= top - h(a) below top and its push is lambda_j (w_j - delta)
-<= min(w_j, z_j - |u|) <= eps (z_j - f_j = w_j), so their e1 distance is at
+<= min(w_j, z_j - |u|) <= eps (z_j - f_j = w_j), so their distance across e2 is at
 least x - eps, and by (*) b is at least c = (E - x)_+ above top, so their
 e2 distance is at least eps + c. Over eps >= 0, (x - eps)_+^2 + (eps + c)^2
 >= (x + c)^2 / 2 and x + c >= E: they stay 2R + nu apart.
