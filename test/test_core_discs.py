@@ -48,6 +48,37 @@ def test_bodies_keep_the_margin_when_the_condition_holds(case):
         assert keeps_margin(p), (refine, p.min_gap, p.gap, p.leg_names[p.gap.leg])
 
 
+@PROPERTY
+@given(st.integers(2, 14), st.integers(1, 3), st.sampled_from([0.5, 1.0, 1.5]),
+       st.integers(0, 2 ** 16))
+def test_balls_keep_the_margin_when_the_condition_holds(count, pillar_count, rho_over_radius,
+                                                        seed):
+    """The theorem in R^3: the stack keeps the balls apart by their distance across e2."""
+    radius = 0.2
+    rng = np.random.default_rng(seed)
+    pillars = rng.uniform(0.0, 4.0, (pillar_count, 3))
+    workspace = Workspace(pillars, variant='discs', robot_radius=radius,
+                          obstacle_radius=rho_over_radius * radius)
+    assume(len(workspace.disc_layout.conflicting_pillars(radius)) == 0)
+    apart = separation(workspace)
+    clear = radius + rho_over_radius * radius
+    configurations = []
+    for _ in range(3):
+        points = np.zeros((0, 3))
+        for _ in range(2000):
+            point = rng.uniform(0.0, 4.0, 3)
+            if (np.all(np.linalg.norm(points - point, axis=1) >= apart)
+                    and np.all(np.linalg.norm(pillars - point, axis=1) >= clear)):
+                points = np.vstack([points, point])
+                if len(points) == count:
+                    break
+        assume(len(points) == count)
+        configurations.append(points)
+    for refine in (False, True):
+        p = plan(workspace, configurations, certify=False, refine=refine)
+        assert keeps_margin(p), (refine, p.min_gap, p.gap, p.leg_names[p.gap.leg])
+
+
 @pytest.mark.parametrize('rho_over_radius', [0.5, 1.0, 1.5])
 @pytest.mark.parametrize('radius', [0.1, 0.25])
 @pytest.mark.parametrize('count', [2, 6, 12])
