@@ -15,10 +15,11 @@ straight-line bound, planned without the walls' refusal in the frame the walls
 choose (core.frame.choose_frame) and in the default frame, side by side.
 
 Why the rest is refused, measured in the walls' frame as shares of the box's side
-(medians): the room between the staging height (above every pillar's zone) and
-the wall e2 points to, against how far above the staging height the construction
-takes the fleet: its rise (core.discs.rise: the fleet compressed to beta = 0.55 of
-its height) and its lanes (core.discs: about 2 sqrt k, a slot's pitch apart).
+(medians): the room between the staging height (above every pillar, by its zone
+or the slots' gap) and the wall e2 points to, against how far above the staging
+height the construction takes the fleet: its rise (core.discs.rise: the fleet
+stacked on the staging height) and its lanes (core.discs: about 2 sqrt k, a
+slot's pitch apart).
 
 Run alone: ``.venv/bin/python bench/hall.py [--quick]``.
 """
@@ -39,6 +40,15 @@ SEED_BASE = 7_000_003
 
 
 @dataclass
+class Heights:
+    """Above the staging height, as shares of the box's side: the room, the rise, the lanes."""
+
+    room: float
+    risen: float
+    lanes: float
+
+
+@dataclass
 class Outcome:
     """One fleet in its hall: planned inside, or the refusal's code and distance."""
 
@@ -46,18 +56,9 @@ class Outcome:
     code: ErrorCode
     length: float
     default_length: float
-    heights: 'Heights'
+    heights: Heights
     beyond: float = float('nan')
     seconds: float = float('nan')
-
-
-@dataclass
-class Heights:
-    """Above the staging height, as shares of the box's side: the room, the rise, the lanes."""
-
-    room: float
-    risen: float
-    lanes: float
 
 
 def hall(fleet) -> np.ndarray:

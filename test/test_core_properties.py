@@ -162,8 +162,9 @@ def test_a_translated_request_gets_the_motion_translated(request, variant, refin
     Moving obstacles and robots by v moves the motion by v: the axis follows the obstacles.
 
     With the frame's origin at 0, obstacles and robots near y = 100 made every robot
-    travel to y = 0 and back (doc/design.md section 4). v is whole, so the moved input
-    is exact; the frame is an axis frame, whose projections v moves exactly too.
+    travel to y = 0 and back (doc/design.md section 4). v is whole, so grid inputs move
+    exactly (float ones up to rounding, which the tolerance covers); the frame is an
+    axis frame, whose projections v moves exactly too.
     """
     obstacles, configurations, _ = request
     d = obstacles.shape[1]

@@ -22,9 +22,10 @@ The construction keeps the paper's skeleton, H(C_m), Gamma, H(C_{m+1})^-1
   staging height top = max_j (h(q_j) + max(z_j, rho_j + g - R)) (above every
   zone, and the slots' gap g - 2R above every pillar) by stacked_heights, so
   every robot ends above every zone, a robot high up rises little, and a robot
-  ends D_p - |dp| above each robot below it within D_p = sqrt 2 g along e1,
-  wherever the weight allows and always within E = sqrt 2 (2R + nu) (beyond
-  STACKED_ROBOTS robots every stop is top - h_min). Meanwhile each robot in
+  ends D_p - |dp| above each robot below it within D_p = sqrt 2 g along e1
+  wherever the weight allows, which under condition (a) is always within
+  E = sqrt 2 (2R + nu) across e2 (beyond STACKED_ROBOTS robots every stop is
+  top - h_min). Meanwhile each robot in
   the shadow of pillar j (|p(x) - p(q_j)| < w_j) is pushed along e1, away from
   p(q_j) on its own side (a robot whose projection equals p(q_j) counts as
   right of it, as the paper's numbering puts robots after obstacles), by
@@ -113,7 +114,8 @@ neither is pushed, their distance across e2 is x and their e2 difference lies
 between y and G_b - G_a: if x >= E they are E apart, otherwise by (*) at
 least min(S, sqrt(x^2 + (E - x)^2)) >= E / sqrt 2 = 2R + nu. (iii)
 Otherwise one is pushed by some j (so it still rises, below top) and the
-other has stopped at or above top: the stopped one is b, the higher. a is
+other has stopped at or above top: the stopped one is b, the higher (the
+rising one has risen at least as much, yet is below G_b). a is
 eps = z_j - u <= top - h(a) below top and its push is lambda_j (w_j - delta)
 <= min(w_j, z_j - |u|) <= eps (z_j - f_j = w_j), so their distance across e2 is at
 least x - eps, and by (*) b is at least c = (E - x)_+ above top, so their
@@ -252,13 +254,14 @@ def stacked_heights(p: np.ndarray, h: np.ndarray, layout: DiscLayout) -> np.ndar
     G_i = max(h_i, top, max_j top + (G_j + D_p - |p_i - p_j| - top)_+ w(h_i - h_j)), with
     D_p = pile_reach = sqrt 2 g and the weight w(y) = clip(y / pile_fade, 0, 1): 0 unless
     robot j is below robot i, so the definition runs from the lowest robot up. Under the
-    theorem's condition (a) a robot within E = sqrt 2 (2R + nu) of j along e1 is at least
-    pile_fade above it, so it ends >= D_p - |dp| above G_j; the weight lets the
+    theorem's condition (a) a robot within E = sqrt 2 (2R + nu) of j across e2 is at
+    least pile_fade above it, so it ends >= D_p - |dp| above G_j; the weight lets the
     requirement fade out continuously as two robots' heights meet, where (a) puts them
-    farther than E apart along e1 (module docstring).
+    farther than E apart across e2 (module docstring).
     """
     least = layout.pile_reach - np.abs(p[:, None] - p[None, :])
-    # pile_fade >= S >= every pillar's reach > 0 wherever there is a pillar to rise past.
+    # pile_fade = sqrt(S^2 - E^2) > 0 wherever there is a pillar to rise past: S >= 4R > E
+    # with a radius, S = the largest reach > 0 without.
     weight = np.clip((h[:, None] - h[None, :]) / layout.pile_fade, 0.0, 1.0)
     floor = np.maximum(h, layout.top)
     heights = floor
