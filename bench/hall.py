@@ -81,26 +81,27 @@ def inside(positions: np.ndarray, bounds: np.ndarray) -> bool:
                 and (bounds[:, 1] - positions - RADIUS >= -rounding).all())
 
 
-def _length_ratio(fleet, frame=None) -> float:
-    """Return the refined plan's length / straight-line bound without walls, in a frame."""
+def _unwalled(fleet, frame=None):
+    """Return the refined plan without walls (so never refused for them), in a frame."""
     workspace = Workspace(fleet.pillars, variant='discs', robot_radius=RADIUS,
                           obstacle_radius=PILLAR, frame=frame)
-    result = plan(workspace, fleet.configurations, certify=False)
-    return length_ratio(result.positions, fleet.configurations)
+    return plan(workspace, fleet.configurations, certify=False)
 
 
-def _heights(fleet, workspace, side) -> Heights:
-    """Return the room above the staging height and what the rise and the lanes take of it."""
+def _heights(fleet, workspace, unwalled, side) -> Heights:
+    """
+    Return the room above the staging height and what the rise and the lanes take of it.
+
+    unwalled is the fleet's plan in the walls' frame without them: its lanes are the
+    construction's.
+    """
     frame, layout = workspace.frame, workspace.disc_layout
     corners = np.stack(np.meshgrid(*workspace.bounds, indexing='ij'), axis=-1).reshape(-1, 2)
     room = float(frame.offset(corners).max()) - RADIUS - layout.top
     risen = max(float((h + rise(p, h, layout).lift[-1]).max())
                 for p, h in zip(frame.project(fleet.configurations),
                                 frame.offset(fleet.configurations)))
-    raw = plan(Workspace(fleet.pillars, variant='discs', robot_radius=RADIUS,
-                         obstacle_radius=PILLAR, frame=frame), fleet.configurations,
-               certify=False, refine=False)
-    lanes = float(raw.lanes.max())
+    lanes = float(unwalled.lanes.max())
     return Heights(room / side, (risen - layout.top) / side, (lanes - layout.top) / side)
 
 
@@ -111,8 +112,10 @@ def run_one(fleet) -> Outcome:
     workspace = Workspace(fleet.pillars, variant='discs', robot_radius=RADIUS,
                           obstacle_radius=PILLAR, bounds=bounds)
     # Lengths with the walls' frame and with the default one, the walls' refusal left out.
-    lengths = _length_ratio(fleet, workspace.frame), _length_ratio(fleet)
-    heights = _heights(fleet, workspace, side)
+    framed = _unwalled(fleet, workspace.frame)
+    lengths = (length_ratio(framed.positions, fleet.configurations),
+               length_ratio(_unwalled(fleet).positions, fleet.configurations))
+    heights = _heights(fleet, workspace, framed, side)
     begin = time.perf_counter()
     try:
         result = plan(workspace, fleet.configurations)
