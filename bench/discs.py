@@ -98,7 +98,7 @@ def condition_fleet(k, n, seed):
                                   obstacle_radius=radii)
         except PlanningError:
             continue
-        if len(workspace.disc_layout.conflicting_pillars(RADIUS)):
+        if len(workspace.disc_layout.conflicting_pillars()):
             continue
         free = cells[pick[len(pillars):]]
         if len(free) < k:

@@ -82,5 +82,5 @@ def lattice_requests(draw):
     except PlanningError as error:  # two pillars in one column share a projection
         assume(error.code != ErrorCode.OBSTACLES_DEGENERATE)
         raise
-    assume(len(workspace.disc_layout.conflicting_pillars(radius)) == 0)
+    assume(len(workspace.disc_layout.conflicting_pillars()) == 0)
     return workspace, np.array(configurations)

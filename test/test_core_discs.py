@@ -59,7 +59,7 @@ def test_balls_keep_the_margin_when_the_condition_holds(count, pillar_count, rho
     pillars = rng.uniform(0.0, 4.0, (pillar_count, 3))
     workspace = Workspace(pillars, variant='discs', robot_radius=radius,
                           obstacle_radius=rho_over_radius * radius)
-    assume(len(workspace.disc_layout.conflicting_pillars(radius)) == 0)
+    assume(len(workspace.disc_layout.conflicting_pillars()) == 0)
     apart = separation(workspace)
     clear = radius + rho_over_radius * radius
     configurations = []
@@ -89,7 +89,7 @@ def test_a_column_between_two_pillars_and_its_mirror(radius, count, rho_over_rad
     gap = 2 * reach + (2 + MARGIN) * radius
     pillars = np.array([[0.0, 2.0], [gap, 2.0]])
     workspace = Workspace(pillars, variant='discs', robot_radius=radius, obstacle_radius=rho)
-    assert len(workspace.disc_layout.conflicting_pillars(radius)) == 0
+    assert len(workspace.disc_layout.conflicting_pillars()) == 0
     pitch = separation(workspace)
     column = np.stack([np.full(count, gap / 2), pitch * np.arange(count) - 3.0], axis=1)
     # Robots whose discs overlap a pillar are not valid input: leave them out.

@@ -171,9 +171,10 @@ class DiscLayout:
     What the construction fixes per workspace: the pillars in frame coordinates and pitches.
 
     reach w_j, full-push and zone half-heights f_j, z_j per pillar, the staging
-    height top (with pillars; without, each segment's staging_height), the pitch
-    g of the slots and the lanes, and the stack's reach D_p and fade
-    (stacked_heights; module docstring).
+    height top (with pillars; without, each segment's staging_height), the least
+    distance apart 2R + nu that every robot pair keeps, the pitch g of the slots
+    and the lanes, and the stack's reach D_p and fade (stacked_heights; module
+    docstring).
     """
 
     frame: Frame
@@ -183,6 +184,7 @@ class DiscLayout:
     full: np.ndarray
     zone: np.ndarray
     top: float
+    apart: float
     pitch: float
     pile_reach: float
     pile_fade: float
@@ -209,9 +211,9 @@ class DiscLayout:
         # allows for the least it must keep, sqrt 2 (2R + nu) (module docstring).
         fade = np.sqrt(max(separation ** 2 - 2.0 * apart ** 2, 0.0))
         return cls(frame, frame.project(obstacles), offsets, reach, FULL * reach, ZONE * reach,
-                   top, pitch, np.sqrt(2.0) * pitch, float(fade))
+                   top, apart, pitch, np.sqrt(2.0) * pitch, float(fade))
 
-    def conflicting_pillars(self, robot_radius: float) -> np.ndarray:
+    def conflicting_pillars(self) -> np.ndarray:
         """
         Return the (c, 2) index pairs j < l of pillars that break condition (c).
 
@@ -219,11 +221,10 @@ class DiscLayout:
         |h(q_j) - h(q_l)| >= z_j + z_l + 2R + nu, z the zone half-heights.
         """
         first, second = np.triu_indices(self.reach.size, 1)
-        apart = (2.0 + MARGIN) * robot_radius
         wide = (np.abs(self.pillar_projections[first] - self.pillar_projections[second])
-                >= self.reach[first] + self.reach[second] + apart)
+                >= self.reach[first] + self.reach[second] + self.apart)
         tall = (np.abs(self.pillar_offsets[first] - self.pillar_offsets[second])
-                >= self.zone[first] + self.zone[second] + apart)
+                >= self.zone[first] + self.zone[second] + self.apart)
         bad = ~(wide | tall)
         return np.stack([first[bad], second[bad]], axis=1)
 
