@@ -569,7 +569,7 @@ class _Block:
             self.common_range = (-self.lower.min(axis=1, keepdims=True),
                                  self.upper.min(axis=1, keepdims=True))
 
-    def clip(self, wanted):
+    def clip(self, wanted: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """
         Return (common (d, 1, N), own (d, k, N)): the wanted totals (d, k, N) within the caps.
 
