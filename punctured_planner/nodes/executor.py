@@ -32,6 +32,7 @@ sent zero velocity and the goal aborts with ``STOPPED`` (the runtime's
 zero velocity once more before the node goes.
 """
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 from dataclasses import field
 import sys
@@ -45,6 +46,8 @@ from punctured_planner_interfaces.msg import Plan
 from rclpy.action import ActionServer
 from rclpy.action import CancelResponse
 from rclpy.action import GoalResponse
+from rclpy.action.server import ServerGoalHandle
+from rclpy.context import Context
 from rclpy.node import Node
 from rclpy.publisher import Publisher
 from rclpy.subscription import Subscription
@@ -52,6 +55,7 @@ from rclpy.task import Future
 from scipy.spatial.transform import Rotation
 
 from ..execution import Execution
+from ..execution import Step
 from ..execution.execution import differential_mask
 from ..ros import conversions
 from ..ros.goals import fleet_state
@@ -102,7 +106,7 @@ class RobotLink:
 class PlanExecutor(Node):
     """Serve ``execute_plan``; track the shared plan clock with every robot of the plan."""
 
-    def __init__(self, **kwargs):
+    def __init__(self, **kwargs: Any) -> None:
         """Declare the parameters, subscribe to ``plan``, serve the action, start the timer."""
         super().__init__(EXECUTOR.node_name, **kwargs)
         self._node_parameters = NodeParameters(self, EXECUTOR)
@@ -129,7 +133,7 @@ class PlanExecutor(Node):
 
     # ------------------------------------------------------------ inputs
 
-    def _on_plan(self, msg):
+    def _on_plan(self, msg: Plan) -> None:
         """Keep a published plan (the last PLAN_HISTORY); subscribe to its robots' odometry."""
         try:
             plan = conversions.known_plan(msg)
@@ -146,28 +150,29 @@ class PlanExecutor(Node):
                                % (plan.plan_id, len(plan.names), plan.reference.duration,
                                   plan.min_gap, plan.tolerance))
 
-    def _link(self, name):
+    def _link(self, name: str) -> None:
         """Create the odometry subscription and command publishers of a robot (once)."""
         if name in self._links:
             return
         self._links[name] = RobotLink(
-            self.create_subscription(Odometry, name + '/odom',
-                                     lambda msg, name=name: self._on_odometry(name, msg),
-                                     STATE),
+            self.create_subscription(
+                Odometry, name + '/odom',
+                lambda msg, name=name: self._on_odometry(name, msg),
+                STATE),
             self.create_publisher(Twist, name + '/cmd_vel', COMMANDS),
             self.create_publisher(PoseStamped, name + '/reference_pose', COMMANDS))
 
-    def _on_odometry(self, name, msg):
+    def _on_odometry(self, name: str, msg: Odometry) -> None:
         self._odometry[name] = conversions.robot_odometry(msg,
                                                           self.get_clock().now().nanoseconds)
 
     # ------------------------------------------------------------ the action
 
-    def _on_goal(self, goal):
+    def _on_goal(self, goal: ExecutePlan.Goal) -> GoalResponse:
         """Accept every goal, unless the process is stopping."""
         return GoalResponse.REJECT if self._stopping else GoalResponse.ACCEPT
 
-    def _on_cancel(self, goal):
+    def _on_cancel(self, goal: ServerGoalHandle) -> CancelResponse:
         """Accept a cancel of the active goal and stop every robot at once."""
         run = self._run
         if run is not None and run.goal is goal:
@@ -175,7 +180,7 @@ class PlanExecutor(Node):
                       % (run.execution.plan_time if run.execution else 0.0))
         return CancelResponse.ACCEPT
 
-    async def _execute(self, goal):
+    async def _execute(self, goal: ServerGoalHandle) -> ExecutePlan.Result:
         """Run one goal to its end; return its ExecutePlan result."""
         previous = self._run
         if previous is not None:
@@ -187,7 +192,8 @@ class PlanExecutor(Node):
         if found.code == Result.NONE:
             found = self._check_per_robot(found)
         if found.code == Result.NONE:
-            run = Run(goal, found.plan, self.get_clock().now().nanoseconds)
+            run = Run(goal, found.plan,
+                      self.get_clock().now().nanoseconds)
             self._run = run
             result = await run.done
         else:
@@ -210,7 +216,7 @@ class PlanExecutor(Node):
             run.ended.set_result(True)
         return result
 
-    async def _wait_for_plan(self, plan_id):
+    async def _wait_for_plan(self, plan_id: int) -> Lookup:
         """Wait up to PLAN_WAIT_SEC for plan ``plan_id`` (0: any) on ``plan``; look it up."""
         heard = Future()
         entry = (plan_id, heard)
@@ -230,21 +236,24 @@ class PlanExecutor(Node):
 
         The same for max_speeds and max_accelerations (which may also be empty).
         """
-        settings, count = self._settings.execution, len(found.plan.names)
+        # found is a plan's (code NONE): its plan is not None
+        settings, count = (self._settings.execution,
+                           len(found.plan.names))
         try:
             differential_mask(settings.drive, count)
             settings.limits(count)
         except ValueError as error:
             return Lookup(found.plan, Result.UNKNOWN_ROBOTS, 'plan %d has robots %s: %s'
-                          % (found.plan.plan_id, ', '.join(found.plan.names), error))
+                          % (found.plan.plan_id,
+                             ', '.join(found.plan.names), error))
         return found
 
-    def _end(self, run, code, message):
+    def _end(self, run: Run, code: int, message: str) -> None:
         """Stop the run's robots, then end its goal with code and message."""
         self._stop_robots(run.plan.names)
         self._finish(run, code, message)
 
-    def _finish(self, run, code, message):
+    def _finish(self, run: Run, code: int, message: str) -> None:
         """End a run with a result (once); the goal's coroutine resumes with it."""
         if run.done.done():
             return
@@ -262,7 +271,7 @@ class PlanExecutor(Node):
 
     # ------------------------------------------------------------ the control loop
 
-    def _control(self):
+    def _control(self) -> None:
         """One control step of the active goal (the timer)."""
         run = self._run
         if run is None:
@@ -349,7 +358,8 @@ class PlanExecutor(Node):
             self.get_logger().info('odometry back; plan clock resumes at %.3f s' % plan_time)
         run.stale = state.stale
 
-    def _publish_step(self, plan, step, state, now_ns):
+    def _publish_step(self, plan: KnownPlan, step: Step, state: FleetState,
+                      now_ns: int) -> None:
         """
         Publish every robot's reference pose and, in mode velocity, its body-frame command.
 
@@ -370,7 +380,7 @@ class PlanExecutor(Node):
             else:
                 link.cmd_vel.publish(conversions.twist(body[i]))
 
-    def _stop_robots(self, names):
+    def _stop_robots(self, names: Iterable[str]) -> None:
         """Send zero velocity to every named robot (mode velocity)."""
         if self._settings.mode != 'velocity':
             return
@@ -393,19 +403,19 @@ class PlanExecutor(Node):
                   % (run.execution.plan_time if run.execution else 0.0))
         return run.ended
 
-    def stop_halted_robots(self):
+    def stop_halted_robots(self) -> None:
         """Send zero velocity again to the robots end_goals stopped: the last command they get."""
         self._stop_robots(self._halted)
 
 
-def executor_nodes(context=None, **kwargs) -> NodeGroup:
+def executor_nodes(context: Context | None = None, **kwargs: Any) -> NodeGroup:
     """Return the executor: at a stop its goal ends STOPPED, its robots stopped."""
     node = PlanExecutor(context=context, **kwargs)
     return NodeGroup([node], before_stop=node.end_goals,
                      before_teardown=node.stop_halted_robots)
 
 
-def main(args=None):
+def main(args: list[str] | None = None) -> int:
     """Run plan_executor until Ctrl-C or SIGTERM; return 0, or 2 for invalid parameters."""
     return run_nodes(EXECUTOR.node_name, executor_nodes, args=args)
 

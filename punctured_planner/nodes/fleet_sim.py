@@ -14,11 +14,13 @@ Nothing to do before teardown: a simulated robot without commands stops by itsel
 """
 
 import sys
+from typing import Any
 
 from geometry_msgs.msg import PoseArray
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 import numpy as np
+from rclpy.context import Context
 from rclpy.node import Node
 from std_msgs.msg import Float64
 
@@ -36,7 +38,7 @@ from ..sim import Fleet
 class FleetSim(Node):
     """Simulate the fleet at ``rate``: commands in, odometry, states and the true gap out."""
 
-    def __init__(self, **kwargs):
+    def __init__(self, **kwargs: Any) -> None:
         """Declare the parameters, build the fleet, subscribe and advertise per robot."""
         super().__init__(FLEET_SIM.node_name, **kwargs)
         self._node_parameters = NodeParameters(self, FLEET_SIM, self._apply_parameters)
@@ -49,8 +51,10 @@ class FleetSim(Node):
         self._odometry = []
         self._sideways_logged: set[int] = set()
         for i, name in enumerate(self._names):
-            self.create_subscription(Twist, name + '/cmd_vel',
-                                     lambda msg, i=i: self._on_command(i, msg), COMMANDS)
+            self.create_subscription(
+                Twist, name + '/cmd_vel',
+                lambda msg, i=i: self._on_command(i, msg),
+                COMMANDS)
             self._odometry.append(self.create_publisher(Odometry, name + '/odom', COMMANDS))
         self._states = self.create_publisher(PoseArray, 'robot_states', COMMANDS)
         self._gap = self.create_publisher(Float64, '~/min_gap', LATCHED)
@@ -59,14 +63,14 @@ class FleetSim(Node):
                                % (len(self._names), settings.frame_id, settings.rate,
                                   self._fleet.min_gap))
 
-    def _seconds(self, now_ns):
+    def _seconds(self, now_ns: int) -> float:
         return (now_ns - self._start_ns) * 1e-9
 
     def _apply_parameters(self, settings: FleetSimSettings, changed: set[str]) -> None:
         """Post-set: the fleet's physics (frame and muted robots are read at every step)."""
         self._fleet.configure(settings.fleet())
 
-    def _on_command(self, robot, msg):
+    def _on_command(self, robot: int, msg: Twist) -> None:
         velocity = np.array([msg.linear.x, msg.linear.y, msg.linear.z])
         if not np.all(np.isfinite(velocity)) or not np.isfinite(msg.angular.z):
             self.get_logger().warning('%s/cmd_vel: non-finite velocity ignored'
@@ -81,14 +85,14 @@ class FleetSim(Node):
         self._fleet.command(robot, velocity, self._seconds(self.get_clock().now().nanoseconds),
                             msg.angular.z)
 
-    def _step(self):
+    def _step(self) -> None:
         """One simulation step and its messages (the timer); a bug is logged, not fatal."""
         try:
             self._step_and_publish()
         except Exception as error:  # noqa: B902 - the simulator keeps running
             self.get_logger().error('step failed: %s: %s' % (type(error).__name__, error))
 
-    def _step_and_publish(self):
+    def _step_and_publish(self) -> None:
         now_ns = self.get_clock().now().nanoseconds
         dt = min((now_ns - self._last_ns) * 1e-9, 5 * self._period)
         self._last_ns = now_ns
@@ -118,12 +122,12 @@ class FleetSim(Node):
         self._gap.publish(Float64(data=float(self._fleet.min_gap)))
 
 
-def fleet_sim_nodes(context=None, **kwargs) -> NodeGroup:
+def fleet_sim_nodes(context: Context | None = None, **kwargs: Any) -> NodeGroup:
     """Return the simulator's node."""
     return NodeGroup([FleetSim(context=context, **kwargs)])
 
 
-def main(args=None):
+def main(args: list[str] | None = None) -> int:
     """Run fleet_sim until Ctrl-C or SIGTERM; return 0, or 2 for invalid parameters."""
     return run_nodes(FLEET_SIM.node_name, fleet_sim_nodes, args=args)
 

@@ -38,11 +38,13 @@ threads joined before anything is destroyed):
 :func:`punctured_planner.ros.runtime.run_nodes`.
 """
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 import gc
 import sys
 import threading
 import traceback
+from typing import Any
 import warnings
 
 from geometry_msgs.msg import PoseArray
@@ -50,10 +52,14 @@ from nav_msgs.msg import Odometry
 from nav_msgs.msg import Path
 from punctured_planner_interfaces.msg import Plan
 from punctured_planner_interfaces.srv import PlanSequence
+from rclpy.context import Context
 from rclpy.node import Node
+from rclpy.publisher import Publisher
+from rclpy.subscription import Subscription
 from std_msgs.msg import UInt32
 from visualization_msgs.msg import MarkerArray
 
+from .. import core
 from ..core import PlanningError
 from ..ros import conversions
 from ..ros import publications
@@ -92,7 +98,7 @@ class AfterReply:
 class PlannerNode(Node):
     """Serve ``plan_sequence``; publish each robot's Path, the domain index and markers."""
 
-    def __init__(self, **kwargs):
+    def __init__(self, **kwargs: Any) -> None:
         """Declare the parameters, subscribe, advertise; raise ValueError for bad parameters."""
         super().__init__(PLANNER.node_name, **kwargs)
         self._lock = threading.Lock()
@@ -113,10 +119,10 @@ class PlannerNode(Node):
         self.inputs.create_subscription(PoseArray, 'obstacles', self._on_obstacles, LATCHED)
         self.inputs.create_subscription(PoseArray, 'robot_states', self._on_robot_states,
                                         STATE)
-        self._odometry_subscriptions = {}
+        self._odometry_subscriptions: dict[str, Subscription] = {}
         self._update_odometry_subscriptions(self._settings.robot_names)
-        self._latched_publishers = {}  # relative topic -> publisher
-        self._latched_names = []
+        self._latched_publishers: dict[str, Publisher] = {}  # relative topic -> publisher
+        self._latched_names: list[str] = []
         for topic, msg_type in (('domain_index', UInt32), ('plan_markers', MarkerArray),
                                 ('plan', Plan)):
             self._publisher(topic, msg_type)
@@ -146,7 +152,7 @@ class PlannerNode(Node):
 
     # ------------------------------------------------------------ parameters
 
-    def _apply_parameters(self, settings, changed):
+    def _apply_parameters(self, settings: PlannerSettings, changed: set[str]) -> None:
         """Post-set: the settings, and obstacles and odometry where their parameters changed."""
         with self._lock:
             self._settings = settings
@@ -158,14 +164,14 @@ class PlannerNode(Node):
         if 'robot_names' in changed:
             self._update_odometry_subscriptions(settings.robot_names)
 
-    def _parameter_obstacles(self, settings):
+    def _parameter_obstacles(self, settings: PlannerSettings) -> ObstacleSet:
         return ObstacleSet(conversions.obstacles_from_parameter(settings.obstacles),
                            frame_id='', source='parameter',
                            stamp_ns=self.get_clock().now().nanoseconds)
 
     # ------------------------------------------------------------ subscriptions
 
-    def _update_odometry_subscriptions(self, names):
+    def _update_odometry_subscriptions(self, names: Iterable[str]) -> None:
         for name in list(self._odometry_subscriptions):
             if name not in names:
                 self.inputs.destroy_subscription(self._odometry_subscriptions.pop(name))
@@ -173,9 +179,10 @@ class PlannerNode(Node):
             if name not in self._odometry_subscriptions:
                 self._odometry_subscriptions[name] = self.inputs.create_subscription(
                     Odometry, name + '/odom',
-                    lambda msg, name=name: self._on_odometry(name, msg), STATE)
+                    lambda msg, name=name: self._on_odometry(name, msg),
+                    STATE)
 
-    def _on_obstacles(self, msg):
+    def _on_obstacles(self, msg: PoseArray) -> None:
         """Take a new obstacle set if it can be planned in; else warn and keep the old one."""
         obstacles = ObstacleSet(conversions.obstacles_from_pose_array(msg),
                                 frame_id=msg.header.frame_id,
@@ -188,13 +195,14 @@ class PlannerNode(Node):
         except PlanningError as error:
             self.get_logger().warning('refused %s: %s: %s; keeping %s' % (
                 obstacles.describe(), error.code.name,
-                error.describe(ObstacleNames(obstacles)), previous.describe()))
+                error.describe(ObstacleNames(obstacles)),
+                previous.describe()))
             return
         with self._lock:
             self._obstacles = obstacles
         self.get_logger().debug('obstacles: %s' % obstacles.describe())
 
-    def _on_robot_states(self, msg):
+    def _on_robot_states(self, msg: PoseArray) -> None:
         positions, orientations = conversions.pose_array_poses(msg)
         state = RobotState(positions, orientations, msg.header.frame_id,
                            conversions.stamp_to_ns(msg.header.stamp), 'robot_states',
@@ -202,7 +210,7 @@ class PlannerNode(Node):
         with self._lock:
             self._robot_states = state
 
-    def _on_odometry(self, name, msg):
+    def _on_odometry(self, name: str, msg: Odometry) -> None:
         entry = conversions.robot_odometry(msg, self.get_clock().now().nanoseconds)
         with self._lock:
             # A late message for a robot just removed from robot_names is dropped.
@@ -212,12 +220,14 @@ class PlannerNode(Node):
     def snapshot(self) -> Snapshot:
         """Return one consistent Snapshot of parameters, obstacles and robot state."""
         with self._lock:
-            return take_snapshot(self._settings, self._obstacles, self._robot_states,
-                                 dict(self._odometry))
+            return take_snapshot(self._settings,
+                                 self._obstacles,
+                                 self._robot_states, dict(self._odometry))
 
     # ------------------------------------------------------------ the service
 
-    def _on_plan_sequence(self, request, response):
+    def _on_plan_sequence(self, request: PlanSequence.Request,
+                          response: PlanSequence.Response) -> PlanSequence.Response:
         # Answer first, collect after: the cyclic collector stays off until the reply is
         # sent (_send_response). A plan's messages are many objects (k x M poses), and a
         # full collection scanning them took 24-40 ms inside the reply of one call in
@@ -231,12 +241,13 @@ class PlannerNode(Node):
             self._resume_collection()
             raise
 
-    def _resume_collection(self):
+    def _resume_collection(self) -> None:
         """Turn the cyclic collector back on if it was on when the call was taken."""
         if self._collecting:
             gc.enable()
 
-    def _plan_request(self, request, response):
+    def _plan_request(self, request: PlanSequence.Request,
+                      response: PlanSequence.Response) -> PlanSequence.Response:
         """Plan one request against a snapshot; keep what to log and publish after the reply."""
         now_ns = self.get_clock().now().nanoseconds
         snapshot = self.snapshot()
@@ -262,7 +273,7 @@ class PlannerNode(Node):
         number, outcome, response = after.number, after.outcome, after.outcome.response
         logger = self.get_logger()
         if outcome.ok:
-            p = outcome.plan
+            p: core.Plan = outcome.plan  # ok: it has its plan
             logger.info('plan_sequence #%d: planned k=%d n=%d, domain %d of %d, clearance '
                         '%.6g, %.3f ms' % (number, p.positions.shape[1],
                                            len(p.waypoint_indices), p.domain_index,
@@ -317,7 +328,7 @@ class PlannerNode(Node):
                 % (number, response.error_code, sequence, attempt, SEND_ATTEMPTS,
                    failed[0].message))
 
-    def _publish_after_reply(self, after):
+    def _publish_after_reply(self, after: AfterReply) -> None:
         """
         Publish an answered plan; a failure is logged and the robots' paths retracted.
 
@@ -363,7 +374,7 @@ class PlannerNode(Node):
         except Exception as error:  # the reply is out already
             self.get_logger().error('could not retract the partial plan: %r' % error)
 
-    def _publisher(self, topic, msg_type):
+    def _publisher(self, topic: str, msg_type: type) -> Publisher:
         """Return the latched publisher of a relative topic (on the outputs node), made once."""
         publisher = self._latched_publishers.get(topic)
         if publisher is None:
@@ -372,13 +383,13 @@ class PlannerNode(Node):
         return publisher
 
 
-def planner_nodes(context=None, **kwargs) -> NodeGroup:
+def planner_nodes(context: Context | None = None, **kwargs: Any) -> NodeGroup:
     """Return the PlannerNode, its inputs and its outputs node: each spun in its own thread."""
     node = PlannerNode(context=context, **kwargs)
     return NodeGroup([node, node.inputs, node.outputs])
 
 
-def main(args=None):
+def main(args: list[str] | None = None) -> int:
     """Run the node until Ctrl-C or SIGTERM; return 0, or 2 for invalid parameters."""
     return run_nodes(PLANNER.node_name, planner_nodes, args=args)
 

@@ -13,11 +13,11 @@ import numpy as np
 _CDR_HEADER = b'\x00\x01\x00\x00'
 
 
-def _align(offset, size):
+def _align(offset: int, size: int) -> int:
     return -(-offset // size) * size
 
 
-def _stamped_pose_dtype(frame, start):
+def _stamped_pose_dtype(frame: bytes, start: int) -> np.dtype:
     """Return the numpy layout of a geometry_msgs/PoseStamped in frame ``frame`` at ``start``."""
     pose = _align(start + 13 + len(frame), 8) - start  # stamp, string (length, bytes, NUL)
     return np.dtype({'names': ['sec', 'nanosec', 'length', 'frame', 'pose'],
@@ -25,7 +25,8 @@ def _stamped_pose_dtype(frame, start):
                      'offsets': [0, 4, 8, 12, pose], 'itemsize': pose + 56})
 
 
-def serialized_paths(frame_id, start_ns, stamps, values):
+def serialized_paths(frame_id: str, start_ns: int, stamps: np.ndarray,
+                     values: np.ndarray) -> list[bytes]:
     """
     Return nav_msgs/Paths serialised, built with numpy: one per row of values (k, M, 7).
 

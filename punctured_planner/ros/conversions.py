@@ -33,6 +33,8 @@ Conventions:
   results with constructed messages.
 """
 
+from collections.abc import Iterable
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -40,6 +42,7 @@ from builtin_interfaces.msg import Duration
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import Point
 from geometry_msgs.msg import Pose
+from geometry_msgs.msg import PoseArray
 from geometry_msgs.msg import PoseStamped
 from geometry_msgs.msg import Quaternion
 from geometry_msgs.msg import Twist
@@ -47,13 +50,18 @@ from geometry_msgs.msg import Vector3
 from nav_msgs.msg import Odometry
 from nav_msgs.msg import Path
 import numpy as np
+import numpy.typing as npt
 from punctured_planner_interfaces.msg import Plan  # type: ignore[attr-defined]
+from punctured_planner_interfaces.srv import PlanSequence
 from std_msgs.msg import Header
 from std_msgs.msg import UInt32
 
 from .cdr import serialized_paths
 from .goals import KnownPlan
+from .settings import PlannerSettings
+from .snapshot import Outcome
 from .snapshot import RobotOdometry
+from .. import core
 from ..execution import Bodies
 from ..execution import Reference
 from ..execution import tracking_tolerance
@@ -63,18 +71,18 @@ IDENTITY = (0.0, 0.0, 0.0, 1.0)
 
 # ---------------------------------------------------------------- messages -> arrays
 
-def pose_array_positions(msg):
+def pose_array_positions(msg: PoseArray) -> np.ndarray:
     """Return the positions of a geometry_msgs/PoseArray as a (k, 3) float array."""
     return np.array([(p.position.x, p.position.y, p.position.z) for p in msg.poses],
                     dtype=float).reshape(-1, 3)
 
 
-def pose_array_poses(msg):
+def pose_array_poses(msg: PoseArray) -> tuple[np.ndarray, np.ndarray]:
     """Return (positions (k, 3), orientations (k, 4): x, y, z, w) of a PoseArray."""
     return pose_arrays_poses([msg])
 
 
-def pose_arrays_poses(messages):
+def pose_arrays_poses(messages: Iterable[PoseArray]) -> tuple[np.ndarray, np.ndarray]:
     """
     Return (positions (N, 3), orientations (N, 4)) of the poses of PoseArrays, in their order.
 
@@ -93,7 +101,7 @@ def pose_arrays_poses(messages):
     return values[:, :3], values[:, 3:]
 
 
-def odometry_pose(msg):
+def odometry_pose(msg: Odometry) -> tuple[np.ndarray, np.ndarray]:
     """Return (position (3,), orientation (4,)) of a nav_msgs/Odometry message."""
     pose = msg.pose.pose
     return (np.array([pose.position.x, pose.position.y, pose.position.z], dtype=float),
@@ -101,29 +109,29 @@ def odometry_pose(msg):
                       pose.orientation.w], dtype=float))
 
 
-def robot_odometry(msg, received_ns):
+def robot_odometry(msg: Odometry, received_ns: int) -> RobotOdometry:
     """Return the RobotOdometry of a nav_msgs/Odometry message that arrived at received_ns."""
     position, orientation = odometry_pose(msg)
     return RobotOdometry(position, orientation, msg.header.frame_id,
                          stamp_to_ns(msg.header.stamp), int(received_ns))
 
 
-def obstacles_from_parameter(values):
+def obstacles_from_parameter(values: npt.ArrayLike) -> np.ndarray:
     """Return the obstacles parameter (flat x, y, z per obstacle) as an (r, 3) array."""
     return np.asarray(values, dtype=float).reshape(-1, 3)
 
 
-def obstacles_from_pose_array(msg):
+def obstacles_from_pose_array(msg: PoseArray) -> np.ndarray:
     """Return the obstacles of a PoseArray (positions; orientations ignored) as (r, 3)."""
     return pose_array_positions(msg)
 
 
-def stamp_to_ns(stamp):
+def stamp_to_ns(stamp: Time) -> int:
     """Return a builtin_interfaces/Time as integer nanoseconds."""
     return int(stamp.sec) * 1000000000 + int(stamp.nanosec)
 
 
-def first_non_finite(values):
+def first_non_finite(values: npt.ArrayLike) -> tuple[int, ...] | None:
     """Return the index tuple of the first non-finite entry of an array, or None."""
     finite = np.isfinite(values)
     if finite.all():  # the usual case: no search
@@ -132,12 +140,12 @@ def first_non_finite(values):
     return tuple(int(i) for i in bad[0]) if bad.size else None
 
 
-def leading_coordinates(points, dimension):
+def leading_coordinates(points: npt.ArrayLike, dimension: int) -> np.ndarray:
     """Return the first ``dimension`` coordinates of (..., 3) points: the core's input."""
     return np.ascontiguousarray(np.asarray(points, dtype=float)[..., :dimension])
 
 
-def to_xyz(points, plane_z=0.0):
+def to_xyz(points: npt.ArrayLike, plane_z: float = 0.0) -> np.ndarray:
     """Return (..., d) points as (..., 3): z = plane_z for d = 2 (d must be 2 or 3)."""
     points = np.asarray(points, dtype=float)
     if points.shape[-1] == 3:
@@ -147,7 +155,7 @@ def to_xyz(points, plane_z=0.0):
     return xyz
 
 
-def normalized_quaternions(quaternions):
+def normalized_quaternions(quaternions: npt.ArrayLike) -> np.ndarray:
     """Return (..., 4) quaternions normalised; zero-length or non-finite ones -> identity."""
     quaternions = np.asarray(quaternions, dtype=float)
     with np.errstate(invalid='ignore', over='ignore'):
@@ -161,7 +169,7 @@ def normalized_quaternions(quaternions):
 
 # ---------------------------------------------------------------- time
 
-def time_from_ns(ns):
+def time_from_ns(ns: int) -> Time:
     """
     Return builtin_interfaces/Time for integer nanoseconds (>= 0).
 
@@ -174,7 +182,7 @@ def time_from_ns(ns):
     return stamp
 
 
-def duration_from_seconds(seconds):
+def duration_from_seconds(seconds: float) -> Duration:
     """
     Return builtin_interfaces/Duration for a finite number of seconds (rounded to ns).
 
@@ -188,14 +196,14 @@ def duration_from_seconds(seconds):
 
 # ---------------------------------------------------------------- arrays -> messages
 
-def robot_names(configured_names, robot_count):
+def robot_names(configured_names: Iterable[str], robot_count: int) -> list[str]:
     """Return the robots' names: the configured ones, or robot_0..robot_{k-1}."""
     if configured_names:
         return list(configured_names)
     return ['robot_%d' % i for i in range(robot_count)]
 
 
-def stamps_ns(start_ns, seconds):
+def stamps_ns(start_ns: int, seconds: npt.ArrayLike) -> np.ndarray:
     """
     Return (M,) integer stamps start_ns + seconds, strictly increasing.
 
@@ -228,13 +236,13 @@ class Paths(list):
     publishes after the reply (msg_docs/topics.md), so the reply does not wait for them.
     """
 
-    def __init__(self, paths, values: PathValues):
+    def __init__(self, paths: Iterable[Path], values: PathValues) -> None:
         """Keep the Paths and the values their bytes are built from."""
         super().__init__(paths)
         self.values = values
 
     @cached_property
-    def serialized(self):
+    def serialized(self) -> list[bytes]:
         """Return each Path as CDR bytes (:func:`~punctured_planner.ros.cdr.serialized_paths`)."""
         values = self.values
         return serialized_paths(values.frame_id, values.start_ns, values.stamps,
@@ -242,7 +250,8 @@ class Paths(list):
                                                axis=-1))
 
 
-def plan_to_paths(samples, orientations, frame_id, start_ns, plane_z=0.0):
+def plan_to_paths(samples: core.Samples, orientations: npt.ArrayLike, frame_id: str,
+                  start_ns: int, plane_z: float = 0.0) -> Paths:
     """
     Return one nav_msgs/Path per robot for a plan's Samples (see the module docstring).
 
@@ -289,7 +298,7 @@ def plan_to_paths(samples, orientations, frame_id, start_ns, plane_z=0.0):
     return Paths(paths, PathValues(frame_id, start_ns, stamps, xyz, quaternions, waypoint))
 
 
-def header(frame_id, stamp_ns):
+def header(frame_id: str, stamp_ns: int) -> Header:
     """
     Return a std_msgs/Header in frame_id (a str) at integer nanoseconds.
 
@@ -302,7 +311,7 @@ def header(frame_id, stamp_ns):
     return message
 
 
-def point_list(xyz):
+def point_list(xyz: npt.ArrayLike) -> list[Point]:
     """
     Return geometry_msgs/Points of (N, 3) values, each filled in place (module docstring).
 
@@ -318,31 +327,33 @@ def point_list(xyz):
     return result
 
 
-def pose(position, orientation=IDENTITY):
+def pose(position: npt.ArrayLike, orientation: npt.ArrayLike = IDENTITY) -> Pose:
     """Return a geometry_msgs/Pose at position (3,) with orientation (x, y, z, w)."""
     x, y, z = np.asarray(position, dtype=float).tolist()
     qx, qy, qz, qw = np.asarray(orientation, dtype=float).tolist()
     return Pose(position=Point(x=x, y=y, z=z), orientation=Quaternion(x=qx, y=qy, z=qz, w=qw))
 
 
-def pose_stamped(stamp_header, position, orientation=IDENTITY):
+def pose_stamped(stamp_header: Header, position: npt.ArrayLike,
+                 orientation: npt.ArrayLike = IDENTITY) -> PoseStamped:
     """Return a geometry_msgs/PoseStamped with a shared Header."""
     return PoseStamped(header=stamp_header, pose=pose(position, orientation))
 
 
-def vector3(values):
+def vector3(values: npt.ArrayLike) -> Vector3:
     """Return a geometry_msgs/Vector3 of a (3,) array."""
     x, y, z = np.asarray(values, dtype=float).tolist()
     return Vector3(x=x, y=y, z=z)
 
 
-def twist(linear=(0.0, 0.0, 0.0), yaw_rate=0.0):
+def twist(linear: npt.ArrayLike = (0.0, 0.0, 0.0), yaw_rate: float = 0.0) -> Twist:
     """Return a geometry_msgs/Twist of linear velocity (3,) and angular z: zero by default."""
     return Twist(linear=vector3(linear), angular=Vector3(z=float(yaw_rate)))
 
 
-def odometry(stamp_header, child_frame_id, position, velocity, orientation=IDENTITY,
-             yaw_rate=0.0):
+def odometry(stamp_header: Header, child_frame_id: str, position: npt.ArrayLike,
+             velocity: npt.ArrayLike, orientation: npt.ArrayLike = IDENTITY,
+             yaw_rate: float = 0.0) -> Odometry:
     """Return a nav_msgs/Odometry: pose position (3,), orientation; twist velocity (3,), yaw."""
     message = Odometry(header=stamp_header, child_frame_id=child_frame_id)
     message.pose.pose = pose(position, orientation)
@@ -350,19 +361,21 @@ def odometry(stamp_header, child_frame_id, position, velocity, orientation=IDENT
     return message
 
 
-def domain_index_message(plan):
+def domain_index_message(plan: core.Plan) -> UInt32:
     """Return the std_msgs/UInt32 domain index of a plan."""
     return UInt32(data=int(plan.domain_index))
 
 
-def empty_path(frame_id, stamp_ns):
+def empty_path(frame_id: str, stamp_ns: int) -> Path:
     """Return a nav_msgs/Path with no poses: 'no current plan' for a robot."""
     return Path(header=header(frame_id, stamp_ns))
 
 
 # ---------------------------------------------------------------- the response
 
-def fill_response(response, plan, paths, planning_time, duration, waypoints, dropped=()):
+def fill_response(response: PlanSequence.Response, plan: core.Plan, paths: Sequence[Path],
+                  planning_time: float, duration: float, waypoints: npt.ArrayLike,
+                  dropped: Iterable[int] = ()) -> PlanSequence.Response:
     """Fill every field of a PlanSequence response from a successful plan lasting duration s."""
     response.error_code = 0
     response.error_msg = ''
@@ -382,7 +395,9 @@ def fill_response(response, plan, paths, planning_time, duration, waypoints, dro
     return response
 
 
-def fill_error(response, code, message, planning_time=0.0, clearance=None, gap=None):
+def fill_error(response: PlanSequence.Response, code: int, message: str,
+               planning_time: float = 0.0, clearance: core.Clearance | None = None,
+               gap: core.Clearance | None = None) -> PlanSequence.Response:
     """
     Fill a PlanSequence response for a refused request (no plan, no paths).
 
@@ -408,26 +423,29 @@ def fill_error(response, code, message, planning_time=0.0, clearance=None, gap=N
 
 # ---------------------------------------------------------------- the plan for execution
 
-def plan_message(outcome, settings):
+def plan_message(outcome: Outcome, settings: PlannerSettings) -> Plan:
     """
     Return the punctured_planner_interfaces/Plan of a successful Outcome (topic ``plan``).
 
     The bodies are the workspace's (robot radius, obstacles and their radii); the
     tracking tolerance is execution.tracking_tolerance(min_gap).
     """
+    # a successful Outcome has its plan, names and paths (Outcome's fields are Optional)
     workspace = outcome.plan.workspace
     obstacles = [Point(x=x, y=y, z=z) for x, y, z in
                  to_xyz(workspace.obstacles, settings.plane_z).reshape(-1, 3).tolist()]
     min_gap = float(outcome.plan.min_gap)
-    return Plan(plan_id=int(outcome.plan_id), robot_names=list(outcome.names),
-                paths=list(outcome.paths), max_speed=float(outcome.max_speed),
+    return Plan(plan_id=int(outcome.plan_id),
+                robot_names=list(outcome.names),
+                paths=list(outcome.paths),
+                max_speed=float(outcome.max_speed),
                 max_acceleration=float(outcome.max_acceleration),
                 robot_radius=float(workspace.robot_radius), obstacles=obstacles,
                 obstacle_radii=np.asarray(workspace.obstacle_radii, dtype=float).tolist(),
                 min_gap=min_gap, tracking_tolerance=tracking_tolerance(min_gap))
 
 
-def path_arrays(path):
+def path_arrays(path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Return (stamps ns (M,), positions (M, 3), orientations (M, 4)) of a Path's poses."""
     rows = [(stamp_to_ns(p.header.stamp), p.pose.position.x, p.pose.position.y,
              p.pose.position.z, p.pose.orientation.x, p.pose.orientation.y,
@@ -437,7 +455,7 @@ def path_arrays(path):
     return stamps, values[:, :3], values[:, 3:]
 
 
-def plan_reference(msg):
+def plan_reference(msg: Plan) -> Reference:
     """
     Return the execution.Reference of a Plan message (seconds from its first stamp).
 
@@ -458,14 +476,14 @@ def plan_reference(msg):
                            float(msg.max_acceleration), float(msg.min_gap))
 
 
-def plan_bodies(msg):
+def plan_bodies(msg: Plan) -> Bodies:
     """Return the execution.Bodies of a Plan message (robot radius, obstacles and radii)."""
     obstacles = np.array([(p.x, p.y, p.z) for p in msg.obstacles], dtype=float).reshape(-1, 3)
     return Bodies(float(msg.robot_radius), obstacles,
                   np.asarray(msg.obstacle_radii, dtype=float).reshape(-1))
 
 
-def known_plan(msg):
+def known_plan(msg: Plan) -> KnownPlan:
     """Return the KnownPlan of a Plan message; raise ValueError for a plan without one clock."""
     reference = plan_reference(msg)
     return KnownPlan(int(msg.plan_id), tuple(msg.robot_names), msg.paths[0].header.frame_id,

@@ -10,6 +10,7 @@ configuration C_m) and ``labels`` (robot names at C_1); with radii also
 robots' discs at each C_m, translucent, of diameter 2 robot_radius).
 """
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 from geometry_msgs.msg import Vector3
@@ -23,6 +24,8 @@ from .conversions import header
 from .conversions import point_list
 from .conversions import robot_names
 from .conversions import to_xyz
+from ..core import Plan
+from ..core import Workspace
 
 # Height (m) of the cylinder drawn for a pillar with a radius.
 PILLAR_HEIGHT = 1.0
@@ -36,12 +39,12 @@ PALETTE = (
 _BLACK = (0.0, 0.0, 0.0, 1.0)
 
 
-def _colour(index, alpha=1.0):
+def _colour(index: int, alpha: float = 1.0) -> ColorRGBA:
     r, g, b = PALETTE[index % len(PALETTE)]
     return ColorRGBA(r=r, g=g, b=b, a=alpha)
 
 
-def _rgba(r, g, b, a):
+def _rgba(r: float, g: float, b: float, a: float) -> ColorRGBA:
     return ColorRGBA(r=r, g=g, b=b, a=a)
 
 
@@ -53,7 +56,8 @@ class _Drawing:
     plane_z: float
     scale: float
 
-    def marker(self, ns, marker_id, kind, colour, size, points=()):
+    def marker(self, ns: str, marker_id: int, kind: int, colour: ColorRGBA, size: float,
+               points: np.ndarray | Sequence[Sequence[float]] = ()) -> Marker:
         """Return one ADD marker of the plan's header, unit orientation, uniform scale."""
         item = Marker(header=self.header, ns=ns, id=marker_id, type=kind, action=Marker.ADD,
                       scale=Vector3(x=size, y=size, z=size), color=colour)
@@ -62,7 +66,8 @@ class _Drawing:
         return item
 
 
-def plan_markers(plan, frame_id, stamp_ns, plane_z=0.0, names=None, max_speed=1.0):
+def plan_markers(plan: Plan, frame_id: str, stamp_ns: int, plane_z: float = 0.0,
+                 names: Sequence[str] | None = None, max_speed: float = 1.0) -> MarkerArray:
     """Return a visualization_msgs/MarkerArray of the plan for RViz (module docstring)."""
     drawing = _Drawing(header(frame_id, stamp_ns), plane_z,
                        float(plan.workspace.lane_spacing))
@@ -76,7 +81,7 @@ def plan_markers(plan, frame_id, stamp_ns, plane_z=0.0, names=None, max_speed=1.
     return MarkerArray(markers=markers)
 
 
-def _obstacle_markers(drawing, workspace):
+def _obstacle_markers(drawing: _Drawing, workspace: Workspace) -> list[Marker]:
     """Return the obstacles' spheres and, for those with a radius, their pillars."""
     obstacles = to_xyz(workspace.obstacles, drawing.plane_z).reshape(-1, 3)
     markers = []
@@ -94,7 +99,7 @@ def _obstacle_markers(drawing, workspace):
     return markers
 
 
-def _line_markers(drawing, plan, max_speed):
+def _line_markers(drawing: _Drawing, plan: Plan, max_speed: float) -> list[Marker]:
     """Return the frame axis, the lanes and every robot's path through its breakpoints."""
     width = 0.05 * drawing.scale
     axis = to_xyz(plan.axis_segment(), drawing.plane_z)
@@ -110,7 +115,7 @@ def _line_markers(drawing, plan, max_speed):
     return markers
 
 
-def _waypoint_markers(drawing, plan, positions):
+def _waypoint_markers(drawing: _Drawing, plan: Plan, positions: np.ndarray) -> list[Marker]:
     """Return every C_m in the robots' colours and, with a radius, their bodies."""
     k = positions.shape[1]
     radius = plan.workspace.robot_radius
@@ -128,7 +133,8 @@ def _waypoint_markers(drawing, plan, positions):
     return markers
 
 
-def _label_markers(drawing, positions, names):
+def _label_markers(drawing: _Drawing, positions: np.ndarray,
+                   names: Sequence[str]) -> list[Marker]:
     """Return every robot's name above its place in C_1."""
     markers = []
     for i, name in enumerate(names[:positions.shape[1]]):

@@ -11,16 +11,17 @@ import array
 import importlib
 import math
 import re
+from typing import Any
 
 _SEQUENCE = re.compile(r'^sequence<(?P<inner>[^,>]+)(?:, *\d+)?>$')
 _ARRAY = re.compile(r'^(?P<inner>[^\[]+)\[\d+\]$')
 
 
-def _is_message(value):
+def _is_message(value: object) -> bool:
     return hasattr(type(value), 'get_fields_and_field_types')
 
 
-def _message_class(type_name):
+def _message_class(type_name: str) -> type | None:
     """Return the class for a field type such as ``geometry_msgs/PoseArray``."""
     package, _, name = type_name.partition('/')
     if not name:
@@ -28,7 +29,7 @@ def _message_class(type_name):
     return getattr(importlib.import_module(package + '.msg'), name)
 
 
-def _element_type(type_name):
+def _element_type(type_name: str) -> str | None:
     for pattern in (_SEQUENCE, _ARRAY):
         match = pattern.match(type_name)
         if match:
@@ -36,7 +37,7 @@ def _element_type(type_name):
     return None
 
 
-def _integer_range(type_name):
+def _integer_range(type_name: str) -> tuple[int, int]:
     """Return (lowest, highest) of an IDL integer type name such as 'int32' or 'uint16'."""
     bits = int(''.join(c for c in type_name if c.isdigit()) or 8)
     if type_name.startswith('u') or type_name in ('octet', 'char'):
@@ -44,7 +45,7 @@ def _integer_range(type_name):
     return -2 ** (bits - 1), 2 ** (bits - 1) - 1
 
 
-def _convert_scalar(type_name, value, where):
+def _convert_scalar(type_name: str, value: Any, where: str) -> Any:
     if type_name == 'boolean':
         if not isinstance(value, bool):
             raise ValueError('%s: expected true or false, got %r' % (where, value))
@@ -67,7 +68,7 @@ def _convert_scalar(type_name, value, where):
     return value
 
 
-def _convert(type_name, current, value, where):
+def _convert(type_name: str, current: Any, value: Any, where: str) -> Any:
     element = _element_type(type_name)
     if element is not None:
         if not isinstance(value, (list, tuple)):
@@ -83,7 +84,7 @@ def _convert(type_name, current, value, where):
     return _convert_scalar(type_name, value, where)
 
 
-def fill_message(msg, data, where='request'):
+def fill_message(msg: Any, data: Any, where: str = 'request') -> Any:
     """
     Set the fields of ``msg`` from a dict (nested dicts for nested messages).
 
@@ -104,7 +105,7 @@ def fill_message(msg, data, where='request'):
     return msg
 
 
-def message_to_dict(msg):
+def message_to_dict(msg: Any) -> Any:
     """Return ``msg`` as plain dicts, lists and scalars (YAML/JSON friendly)."""
     if _is_message(msg):
         return {name: message_to_dict(getattr(msg, name))
@@ -118,7 +119,7 @@ def message_to_dict(msg):
     return msg
 
 
-def constant_names(cls, value):
+def constant_names(cls: type, value: int) -> list[str]:
     """Return the names of the integer constants of ``cls`` equal to ``value``."""
     return [name for name in dir(cls)
             if name.isupper() and not name.startswith('_')

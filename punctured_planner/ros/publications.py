@@ -17,6 +17,8 @@ from visualization_msgs.msg import MarkerArray
 from .conversions import domain_index_message
 from .conversions import plan_message
 from .markers import plan_markers
+from .settings import PlannerSettings
+from .snapshot import Outcome
 
 
 @dataclass(frozen=True)
@@ -27,14 +29,14 @@ class Publication:
     msg_type: type
     data: object
 
-    def serialized(self):
+    def serialized(self) -> bytes:
         """Return the message as CDR bytes (as published)."""
         if isinstance(self.data, bytes):
             return self.data
         return serialize_message(self.data)
 
 
-def plan_messages(outcome, settings):
+def plan_messages(outcome: Outcome, settings: PlannerSettings) -> list[Publication]:
     """
     Return the Publications of a successful planning Outcome, as the node publishes them.
 
@@ -43,12 +45,16 @@ def plan_messages(outcome, settings):
     ``plan_markers``, ``domain_index``, then ``plan`` (the Plan message, last: an
     executor never sees a plan whose paths are not out).
     """
+    # a successful Outcome has its plan, names and Paths (Outcome's fields are Optional)
     messages = [Publication('%s/plan' % name.strip('/'), Path, data)
-                for name, data in zip(outcome.names, outcome.paths.serialized)]
+                for name, data in zip(outcome.names,
+                                      outcome.paths.serialized)]
     messages.append(Publication('plan_markers', MarkerArray, plan_markers(
-        outcome.plan, settings.frame_id, outcome.start_ns, settings.plane_z, outcome.names,
+        outcome.plan,
+        settings.frame_id, outcome.start_ns, settings.plane_z, outcome.names,
         outcome.max_speed)))
-    messages.append(Publication('domain_index', UInt32, domain_index_message(outcome.plan)))
+    messages.append(Publication('domain_index', UInt32,
+                                domain_index_message(outcome.plan)))
     plan = plan_message(outcome, settings)
     messages.append(Publication('plan', type(plan), plan))
     return messages

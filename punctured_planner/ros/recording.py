@@ -18,11 +18,18 @@ Every message is logged at the plan's start stamp. A metadata record
 ``punctured_planner`` carries the plan's figures (domain, clearance, ...).
 """
 
+from collections.abc import Iterable
+from collections.abc import Mapping
+from collections.abc import Sequence
 import importlib
 import os
 import re
 
 import numpy as np
+
+from .settings import PlannerSettings
+from .snapshot import Outcome
+from ..core import Plan
 
 _SEPARATOR = '=' * 80
 _PRIMITIVES = {'bool', 'byte', 'char', 'float32', 'float64', 'int8', 'uint8', 'int16',
@@ -30,13 +37,14 @@ _PRIMITIVES = {'bool', 'byte', 'char', 'float32', 'float64', 'int8', 'uint8', 'i
 _FIELD = re.compile(r'^\s*(?P<type>[A-Za-z][\w/]*)(?P<array>\[[^\]]*\])?(?:<=\d+)?\s+\w+')
 
 
-def _share_prefixes(package):
+def _share_prefixes(package: str) -> list[str]:
     """Return the install prefixes where ``share/<package>`` may be, best first."""
     prefixes = [p for p in os.environ.get('AMENT_PREFIX_PATH', '').split(os.pathsep) if p]
     try:
         module = importlib.import_module(package)
         # <prefix>/lib/pythonX.Y/site-packages/<package>/__init__.py
-        here = os.path.dirname(os.path.abspath(module.__file__))
+        here: str = os.path.dirname(
+            os.path.abspath(module.__file__))
         prefixes.append(os.path.dirname(os.path.dirname(os.path.dirname(
             os.path.dirname(here)))))
     except ImportError:
@@ -44,7 +52,7 @@ def _share_prefixes(package):
     return prefixes
 
 
-def message_definition_file(type_name):
+def message_definition_file(type_name: str) -> str:
     """Return the path of the installed .msg file of ``pkg/msg/Type``; raise LookupError."""
     package, _, name = type_name.split('/')
     for prefix in _share_prefixes(package):
@@ -54,7 +62,7 @@ def message_definition_file(type_name):
     raise LookupError('no installed definition %s.msg for %s' % (name, type_name))
 
 
-def _dependencies(text, package):
+def _dependencies(text: str, package: str) -> list[str]:
     """Return the complex field types of a .msg text as 'pkg/msg/Type' names, in order."""
     found = []
     for line in text.splitlines():
@@ -76,17 +84,17 @@ def _dependencies(text, package):
     return found
 
 
-def message_definition(type_name):
+def message_definition(type_name: str) -> str:
     """
     Return the complete ros2msg definition text of ``pkg/msg/Type``.
 
     The type's own .msg text first, then each nested type once (depth first)
     after an 80-character ``=`` line and ``MSG: pkg/msg/Type``.
     """
-    texts = {}
-    order = []
+    texts: dict[str, str] = {}
+    order: list[str] = []
 
-    def visit(name):
+    def visit(name: str) -> None:
         with open(message_definition_file(name), encoding='utf-8') as stream:
             text = stream.read()
         texts[name] = text
@@ -102,12 +110,14 @@ def message_definition(type_name):
     return '\n'.join(parts) + '\n'
 
 
-def _type_name(msg_type):
+def _type_name(msg_type: type) -> str:
     """Return 'pkg/msg/Type' of a generated ROS 2 message class."""
     return '%s/msg/%s' % (msg_type.__module__.split('.')[0], msg_type.__name__)
 
 
-def write_mcap(path, messages, log_time_ns, metadata=None):
+def write_mcap(path: str | os.PathLike[str], messages: Iterable[tuple[str, object]],
+               log_time_ns: int | Sequence[int],
+               metadata: Mapping[str, object] | None = None) -> str | os.PathLike[str]:
     """
     Write [(topic, message)] to an MCAP file at ``path``; return the path.
 
@@ -141,7 +151,8 @@ def write_mcap(path, messages, log_time_ns, metadata=None):
                 channels[topic] = writer.register_channel(
                     topic=topic, message_encoding=MessageEncoding.CDR,
                     schema_id=schemas[type_name])
-            stamp = int(log_time_ns if np.ndim(log_time_ns) == 0 else log_time_ns[sequence])
+            stamp = int(log_time_ns if np.ndim(log_time_ns) == 0
+                        else log_time_ns[sequence])
             writer.add_message(channel_id=channels[topic], log_time=stamp,
                                publish_time=stamp, sequence=sequence,
                                data=message.serialized())
@@ -152,15 +163,17 @@ def write_mcap(path, messages, log_time_ns, metadata=None):
     return path
 
 
-def record_plan(path, outcome, settings):
+def record_plan(path: str | os.PathLike[str], outcome: Outcome,
+                settings: PlannerSettings) -> str | os.PathLike[str]:
     """Write a successful planning Outcome to an MCAP file (see the module docstring)."""
-    p = outcome.plan
+    p: Plan = outcome.plan  # a success has its plan
     metadata = {
         'domain_index': p.domain_index, 'domain_count': p.domain_count,
         'domain': p.domain, 'sequential_complexity': p.sequential_complexity or 0,
         'optimal': p.optimal, 'min_clearance': repr(float(p.min_clearance)),
         'variant': p.variant, 'frame_id': settings.frame_id,
-        'max_speed': outcome.max_speed, 'robots': ','.join(outcome.names),
+        'max_speed': outcome.max_speed,
+        'robots': ','.join(outcome.names),
         'projection_counts': ','.join(str(int(c)) for c in p.projection_counts),
     }
     from .publications import plan_messages
