@@ -155,10 +155,9 @@ class PlanExecutor(Node):
         if name in self._links:
             return
         self._links[name] = RobotLink(
-            self.create_subscription(
-                Odometry, name + '/odom',
-                lambda msg, name=name: self._on_odometry(name, msg),
-                STATE),
+            self.create_subscription(Odometry, name + '/odom',
+                                     lambda msg, name=name: self._on_odometry(name, msg),
+                                     STATE),
             self.create_publisher(Twist, name + '/cmd_vel', COMMANDS),
             self.create_publisher(PoseStamped, name + '/reference_pose', COMMANDS))
 
@@ -192,8 +191,7 @@ class PlanExecutor(Node):
         if found.code == Result.NONE:
             found = self._check_per_robot(found)
         if found.code == Result.NONE:
-            run = Run(goal, found.plan,
-                      self.get_clock().now().nanoseconds)
+            run = Run(goal, found.plan, self.get_clock().now().nanoseconds)
             self._run = run
             result = await run.done
         else:
@@ -244,8 +242,7 @@ class PlanExecutor(Node):
             settings.limits(count)
         except ValueError as error:
             return Lookup(found.plan, Result.UNKNOWN_ROBOTS, 'plan %d has robots %s: %s'
-                          % (found.plan.plan_id,
-                             ', '.join(found.plan.names), error))
+                          % (found.plan.plan_id, ', '.join(found.plan.names), error))
         return found
 
     def _end(self, run: Run, code: int, message: str) -> None:

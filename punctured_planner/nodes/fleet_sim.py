@@ -51,10 +51,8 @@ class FleetSim(Node):
         self._odometry = []
         self._sideways_logged: set[int] = set()
         for i, name in enumerate(self._names):
-            self.create_subscription(
-                Twist, name + '/cmd_vel',
-                lambda msg, i=i: self._on_command(i, msg),
-                COMMANDS)
+            self.create_subscription(Twist, name + '/cmd_vel',
+                                     lambda msg, i=i: self._on_command(i, msg), COMMANDS)
             self._odometry.append(self.create_publisher(Odometry, name + '/odom', COMMANDS))
         self._states = self.create_publisher(PoseArray, 'robot_states', COMMANDS)
         self._gap = self.create_publisher(Float64, '~/min_gap', LATCHED)

@@ -179,8 +179,7 @@ class PlannerNode(Node):
             if name not in self._odometry_subscriptions:
                 self._odometry_subscriptions[name] = self.inputs.create_subscription(
                     Odometry, name + '/odom',
-                    lambda msg, name=name: self._on_odometry(name, msg),
-                    STATE)
+                    lambda msg, name=name: self._on_odometry(name, msg), STATE)
 
     def _on_obstacles(self, msg: PoseArray) -> None:
         """Take a new obstacle set if it can be planned in; else warn and keep the old one."""
@@ -195,8 +194,7 @@ class PlannerNode(Node):
         except PlanningError as error:
             self.get_logger().warning('refused %s: %s: %s; keeping %s' % (
                 obstacles.describe(), error.code.name,
-                error.describe(ObstacleNames(obstacles)),
-                previous.describe()))
+                error.describe(ObstacleNames(obstacles)), previous.describe()))
             return
         with self._lock:
             self._obstacles = obstacles
@@ -220,9 +218,8 @@ class PlannerNode(Node):
     def snapshot(self) -> Snapshot:
         """Return one consistent Snapshot of parameters, obstacles and robot state."""
         with self._lock:
-            return take_snapshot(self._settings,
-                                 self._obstacles,
-                                 self._robot_states, dict(self._odometry))
+            return take_snapshot(self._settings, self._obstacles, self._robot_states,
+                                 dict(self._odometry))
 
     # ------------------------------------------------------------ the service
 

@@ -43,8 +43,7 @@ def _share_prefixes(package: str) -> list[str]:
     try:
         module = importlib.import_module(package)
         # <prefix>/lib/pythonX.Y/site-packages/<package>/__init__.py
-        here: str = os.path.dirname(
-            os.path.abspath(module.__file__))
+        here: str = os.path.dirname(os.path.abspath(module.__file__))
         prefixes.append(os.path.dirname(os.path.dirname(os.path.dirname(
             os.path.dirname(here)))))
     except ImportError:
@@ -151,8 +150,7 @@ def write_mcap(path: str | os.PathLike[str], messages: Iterable[tuple[str, objec
                 channels[topic] = writer.register_channel(
                     topic=topic, message_encoding=MessageEncoding.CDR,
                     schema_id=schemas[type_name])
-            stamp = int(log_time_ns if np.ndim(log_time_ns) == 0
-                        else log_time_ns[sequence])
+            stamp = int(log_time_ns if np.ndim(log_time_ns) == 0 else log_time_ns[sequence])
             writer.add_message(channel_id=channels[topic], log_time=stamp,
                                publish_time=stamp, sequence=sequence,
                                data=message.serialized())
@@ -172,8 +170,7 @@ def record_plan(path: str | os.PathLike[str], outcome: Outcome,
         'domain': p.domain, 'sequential_complexity': p.sequential_complexity or 0,
         'optimal': p.optimal, 'min_clearance': repr(float(p.min_clearance)),
         'variant': p.variant, 'frame_id': settings.frame_id,
-        'max_speed': outcome.max_speed,
-        'robots': ','.join(outcome.names),
+        'max_speed': outcome.max_speed, 'robots': ','.join(outcome.names),
         'projection_counts': ','.join(str(int(c)) for c in p.projection_counts),
     }
     from .publications import plan_messages
