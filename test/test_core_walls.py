@@ -245,17 +245,24 @@ def test_bounds_are_validated_with_the_expected_and_the_given_shape():
               'got shape (4,)'),
              ([[0, 1], [0, 1], [0, 1]], 'shape (d, 2) = (2, 2), one [min, max] per axis; got '
               'shape (3, 2)'),
-             ([[0, 1], [0, np.inf]], 'bounds must be finite; y_max is inf'),
-             ([[0, 1], [2, 2]], 'bounds: y_min = 2 must be below y_max = 2'),
-             ([[3, 1], [0, 1]], 'bounds: x_min = 3 must be below x_max = 1'),
+             ([[0, 1], [0, np.inf]], 'bounds must be finite; the wall y_max is inf'),
+             ([[0, 1], [2, 2]], 'bounds: the wall y_min = 2 must be below y_max = 2'),
+             ([[3, 1], [0, 1]], 'bounds: the wall x_min = 3 must be below x_max = 1'),
              ([['a', 'b'], [0, 1]], 'bounds must be real numbers')]
     for bounds, words in cases:
         with pytest.raises(PlanningError) as error:
             Workspace(np.zeros((0, 2)), bounds=bounds)
         assert error.value.code == ErrorCode.INVALID_REQUEST
         assert words in str(error.value), str(error.value)
-    with pytest.raises(PlanningError, match=r'x3_min = 1 must be below x3_max = 0'):
+    with pytest.raises(PlanningError, match=r'the wall x3_min = 1 must be below x3_max = 0'):
         checked_bounds([[0, 1]] * 3 + [[1, 0]], 4)
+    # the wall at fault is data too: the non-finite one, or the low of an empty axis
+    for bounds, wall in (([[0, 1], [0, np.inf]], Wall(1, True)),
+                         ([[0, 1], [np.nan, 1]], Wall(1, False)),
+                         ([[3, 1], [0, 1]], Wall(0, False))):
+        with pytest.raises(PlanningError) as error:
+            checked_bounds(bounds, 2)
+        assert error.value.wall == wall, (bounds, error.value.wall)
 
 
 def test_outside_workspace_ranks_beside_robot_on_obstacle_and_clearance_below_required():

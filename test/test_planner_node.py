@@ -368,7 +368,8 @@ def test_parameters_over_the_parameter_service(planner, ros_client):
     answer = result(remote.set_parameters([Parameter('workspace_bounds',
                                                      value=[0.0, 5.0, 3.0, 1.0])]))
     assert not answer.results[0].successful
-    assert 'y_min = 3 must be below y_max = 1' in answer.results[0].reason
+    assert ('the wall y_min (workspace_bounds[2]) = 3 must be below y_max = 1'
+            in answer.results[0].reason), answer.results[0].reason
     answer = result(remote.set_parameters([Parameter('workspace_bounds',
                                                      value=[0.0, 5.0, 0.0, 1.0, 0.0, 1.0])]))
     assert not answer.results[0].successful

@@ -59,7 +59,8 @@ def checked_bounds(bounds: npt.ArrayLike | None, dimension: int) -> np.ndarray |
     Return bounds as a float (d, 2) array of [low, high] per axis, or None for none.
 
     Raises INVALID_REQUEST, saying which shape was expected and which arrived,
-    for a non-finite value, or for a low not below its high.
+    for a non-finite value, or for a low not below its high (the wall at fault
+    as ``wall``: the non-finite one, or the low).
     """
     if bounds is None:
         return None
@@ -76,13 +77,15 @@ def checked_bounds(bounds: npt.ArrayLike | None, dimension: int) -> np.ndarray |
     if bad.size:
         wall = Wall(int(bad[0][0]), bool(bad[0][1]))
         raise PlanningError(ErrorCode.INVALID_REQUEST,
-                            f'bounds must be finite; {wall.name} is {array[tuple(bad[0])]}')
+                            f'bounds must be finite; {{wall}} is {array[tuple(bad[0])]}',
+                            wall=wall)
     empty = np.flatnonzero(~(array[:, 0] < array[:, 1]))
     if empty.size:
         axis = int(empty[0])
         raise PlanningError(ErrorCode.INVALID_REQUEST,
-                            f'bounds: {Wall(axis, False).name} = {array[axis, 0]:.6g} must be '
-                            f'below {Wall(axis, True).name} = {array[axis, 1]:.6g}')
+                            f'bounds: {{wall}} = {array[axis, 0]:.6g} must be below '
+                            f'{Wall(axis, True).name} = {array[axis, 1]:.6g}',
+                            wall=Wall(axis, False))
     return array
 
 

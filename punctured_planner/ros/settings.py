@@ -22,7 +22,9 @@ from .parameters import ros_names
 from .parameters import Spec
 from .parameters import Table
 from .parameters import within
+from .wording import WallNames
 from ..core import VARIANTS
+from ..core.errors import PlanningError
 from ..core.errors import Wall
 from ..core.walls import checked_bounds
 from ..execution import Bodies
@@ -181,12 +183,12 @@ def _planner_bounds(settings: PlannerSettings) -> None:
     """Refuse workspace_bounds the core refuses (its one rule), or a count not 2 per axis."""
     try:
         checked_bounds(settings.core_bounds, settings.dimension)
-    except ValueError as error:  # a PlanningError: its reason without the code
+    except PlanningError as error:  # its reason without the code, the wall by its entry
         raise ValueError('workspace_bounds %r for dimension %d (%s): %s'
                          % (list(settings.workspace_bounds), settings.dimension,
                             ', '.join(Wall(axis, high).name for axis in range(settings.dimension)
                                       for high in (False, True)),
-                            error.args[0])) from None
+                            error.describe(WallNames()))) from None
 
 
 PLANNER = Table('planner_node', PlannerSettings,

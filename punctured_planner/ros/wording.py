@@ -12,16 +12,27 @@ configurations it plans; ``planned`` maps them back to the request's.
 
 from typing import Callable
 from typing import Sequence
+from typing import TYPE_CHECKING
 
-from .snapshot import ObstacleSet
 from ..core.errors import Names
 from ..core.errors import Wall
 
+if TYPE_CHECKING:  # settings imports this module, and snapshot imports settings
+    from .snapshot import ObstacleSet
 
-class ObstacleNames(Names):
+
+class WallNames(Names):
+    """Walls by the entry of the workspace_bounds parameter that sets them."""
+
+    def wall(self, wall: Wall) -> str:
+        """Return 'the wall x_max (workspace_bounds[1])': the parameter entry that sets it."""
+        return 'the wall %s (workspace_bounds[%d])' % (wall.name, wall.index)
+
+
+class ObstacleNames(WallNames):
     """Obstacles by index, position and source (the node's obstacle set); walls by entry."""
 
-    def __init__(self, obstacles: ObstacleSet) -> None:
+    def __init__(self, obstacles: 'ObstacleSet') -> None:
         """Name the obstacles of ``obstacles``."""
         self._obstacles = obstacles
 
@@ -33,15 +44,11 @@ class ObstacleNames(Names):
         """Return the names of several obstacles, joined by 'and'."""
         return ' and '.join(self._obstacles.name(j) for j in indices)
 
-    def wall(self, wall: Wall) -> str:
-        """Return 'the wall x_max (workspace_bounds[1])': the parameter entry that sets it."""
-        return 'the wall %s (workspace_bounds[%d])' % (wall.name, wall.index)
-
 
 class RequestNames(ObstacleNames):
     """Configurations by their label in the request, obstacles as :class:`ObstacleNames`."""
 
-    def __init__(self, obstacles: ObstacleSet, label: Callable[[int], str],
+    def __init__(self, obstacles: 'ObstacleSet', label: Callable[[int], str],
                  planned: Sequence[int] | None = None) -> None:
         """label(m) names request configuration m; planned[i] is the i-th planned one's m."""
         super().__init__(obstacles)
