@@ -27,6 +27,20 @@ from ..core.timing import corner_jump, fleet_profile, leg_at, speed_profile, Spe
 
 
 @dataclass(frozen=True)
+class Progress:
+    """
+    How far along its segment an interval is at a plan time, and how fast that changes.
+
+    fraction of the segment covered, and its rates per second (speed) and per
+    second squared (acceleration).
+    """
+
+    fraction: float
+    speed: float
+    acceleration: float
+
+
+@dataclass(frozen=True)
 class Reference:
     """
     Breakpoints of a synchronous motion: seconds (M,) from its start, positions (M, k, 3).
@@ -94,24 +108,19 @@ class Reference:
         """Return the index j of the stamp interval [seconds[j], seconds[j+1]) holding s."""
         return int(leg_at(self.seconds, s))
 
-    def _along(self, j: int, s: float) -> tuple[float, float, float]:
-        """
-        Return (fraction, speed, acceleration) of interval j at plan time s.
-
-        fraction of the interval's segment covered, and the rates of that
-        fraction per second and per second squared.
-        """
+    def _along(self, j: int, s: float) -> Progress:
+        """Return the Progress of interval j at plan time s."""
         start, end = self.seconds[j], self.seconds[j + 1]
         if self.profile is None:
-            return (s - start) / (end - start), 1.0 / (end - start), 0.0
+            return Progress((s - start) / (end - start), 1.0 / (end - start), 0.0)
         length = float(self.profile.lengths[j])
         if length <= 0:
-            return 0.0, 0.0, 0.0
+            return Progress(0.0, 0.0, 0.0)
         # the profile's own duration, stretched to the stamps (they differ by rounding)
         scale = float(self.profile.durations()[j]) / (end - start)
         state = self.profile.state_at(j, (s - start) * scale)
-        return (state.distance / length, state.speed * scale / length,
-                state.acceleration * scale * scale / length)
+        return Progress(state.distance / length, state.speed * scale / length,
+                        state.acceleration * scale * scale / length)
 
     def position(self, s: float) -> np.ndarray:
         """Return the (k, 3) reference positions at plan time s (clamped to the plan)."""
@@ -120,7 +129,7 @@ class Reference:
         if s >= self.seconds[-1]:
             return self.positions[-1]
         j = self._interval(s)
-        fraction = self._along(j, s)[0]
+        fraction = self._along(j, s).fraction
         return (1.0 - fraction) * self.positions[j] + fraction * self.positions[j + 1]
 
     def velocity(self, s: float) -> np.ndarray:
@@ -131,14 +140,14 @@ class Reference:
         step = self.positions[j + 1] - self.positions[j]
         if self.profile is None:
             return step / (self.seconds[j + 1] - self.seconds[j])
-        return step * self._along(j, s)[1]
+        return step * self._along(j, s).speed
 
     def acceleration(self, s: float) -> np.ndarray:
         """Return the (k, 3) reference accelerations at plan time s (0 outside, 0 if linear)."""
         if self.seconds.size == 1 or s < self.seconds[0] or s >= self.seconds[-1]:
             return np.zeros_like(self.positions[0])
         j = self._interval(s)
-        return (self.positions[j + 1] - self.positions[j]) * self._along(j, s)[2]
+        return (self.positions[j + 1] - self.positions[j]) * self._along(j, s).acceleration
 
     def orientation(self, s: float) -> np.ndarray:
         """Return the (k, 4) orientations held at plan time s."""
