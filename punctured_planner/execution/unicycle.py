@@ -262,8 +262,8 @@ class Corners:
         """
         k = self.speeds.shape[1] if self.speeds.size else 0
         caps = np.ones(k)
-        first = np.searchsorted(self.seconds, s, side='right')
-        last = np.searchsorted(self.seconds, s + LOOKAHEAD, side='right')
+        first = int(np.searchsorted(self.seconds, s, side='right'))
+        last = int(np.searchsorted(self.seconds, s + LOOKAHEAD, side='right'))
         for b in range(max(first, 1), min(last, len(self.speeds) + 1)):
             before = self.velocities[b - 1]
             after = self.velocities[b] if b < len(self.speeds) else np.zeros_like(before)

@@ -35,6 +35,7 @@ zero velocity once more before the node goes.
 from collections.abc import Iterable
 from dataclasses import dataclass
 from dataclasses import field
+import functools
 import sys
 from typing import Any
 
@@ -156,8 +157,7 @@ class PlanExecutor(Node):
             return
         self._links[name] = RobotLink(
             self.create_subscription(Odometry, name + '/odom',
-                                     lambda msg, name=name: self._on_odometry(name, msg),
-                                     STATE),
+                                     functools.partial(self._on_odometry, name), STATE),
             self.create_publisher(Twist, name + '/cmd_vel', COMMANDS),
             self.create_publisher(PoseStamped, name + '/reference_pose', COMMANDS))
 
@@ -188,10 +188,10 @@ class PlanExecutor(Node):
         if found.code == Result.NO_PLAN:
             found = await self._wait_for_plan(goal.request.plan_id)
         run = None
-        if found.code == Result.NONE:
-            found = self._check_per_robot(found)
-        if found.code == Result.NONE:
-            run = Run(goal, found.plan, self.get_clock().now().nanoseconds)
+        if found.runnable is not None:
+            found = self._check_per_robot(found.runnable)
+        if found.runnable is not None:
+            run = Run(goal, found.runnable, self.get_clock().now().nanoseconds)
             self._run = run
             result = await run.done
         else:
@@ -228,22 +228,20 @@ class PlanExecutor(Node):
             self._plan_waits.remove(entry)
         return self._plans.lookup(plan_id, self.resolve_topic_name('plan'))
 
-    def _check_per_robot(self, found: Lookup) -> Lookup:
+    def _check_per_robot(self, plan: KnownPlan) -> Lookup:
         """
-        Return found, or UNKNOWN_ROBOTS when drive has neither one value nor one per robot.
+        Return plan with NONE, or UNKNOWN_ROBOTS if drive has not one value or one per robot.
 
         The same for max_speeds and max_accelerations (which may also be empty).
         """
-        # found is a plan's (code NONE): its plan is not None
-        settings, count = (self._settings.execution,
-                           len(found.plan.names))
+        settings, count = self._settings.execution, len(plan.names)
         try:
             differential_mask(settings.drive, count)
             settings.limits(count)
         except ValueError as error:
-            return Lookup(found.plan, Result.UNKNOWN_ROBOTS, 'plan %d has robots %s: %s'
-                          % (found.plan.plan_id, ', '.join(found.plan.names), error))
-        return found
+            return Lookup(plan, Result.UNKNOWN_ROBOTS, 'plan %d has robots %s: %s'
+                          % (plan.plan_id, ', '.join(plan.names), error))
+        return Lookup(plan, Result.NONE)
 
     def _end(self, run: Run, code: int, message: str) -> None:
         """Stop the run's robots, then end its goal with code and message."""
@@ -279,7 +277,7 @@ class PlanExecutor(Node):
             self._end(run, Result.UNKNOWN, 'internal error: %s: %s'
                       % (type(error).__name__, error))
 
-    def _control_run(self, run):
+    def _control_run(self, run: Run) -> None:
         """Start the goal's Execution once every robot reported, then step and publish it."""
         now = self.get_clock().now().nanoseconds
         plan, settings = run.plan, self._settings
@@ -288,25 +286,30 @@ class PlanExecutor(Node):
             self._stop_robots(plan.names)
             self._finish(run, Result.FRAME_MISMATCH, state.wrong_frame)
             return
-        if run.execution is None and not self._start(run, state, now):
+        execution = run.execution if run.execution is not None else self._start(run, state, now)
+        if execution is None:
             return
-        if self._hold_expired(run, state, now):
+        if self._hold_expired(run, execution.plan_time, state, now):
             return
-        step = run.execution.step((now - run.last_ns) * 1e-9, state.positions,
-                                  state.stale_mask, state.orientations, state.ages)
+        step = execution.step((now - run.last_ns) * 1e-9, state.positions,
+                              state.stale_mask, state.orientations, state.ages)
         run.last_ns = now
         self._log_stale(run, state, step.plan_time)
         self._publish_step(plan, step, state, now)
         run.goal.publish_feedback(ExecutePlan.Feedback(
-            plan_time=step.plan_time, plan_duration=run.execution.reference.duration,
-            clock_rate=step.rate, max_tracking_errors=run.execution.max_errors.tolist(),
-            min_gap=float(run.execution.min_gap), stale_robots=list(state.stale)))
+            plan_time=step.plan_time, plan_duration=execution.reference.duration,
+            clock_rate=step.rate, max_tracking_errors=execution.max_errors.tolist(),
+            min_gap=float(execution.min_gap), stale_robots=list(state.stale)))
         if step.finished:
             self._stop_robots(plan.names)
             self._finish(run, Result.NONE, 'plan %d executed' % plan.plan_id)
 
-    def _start(self, run: Run, state: FleetState, now: int) -> bool:
-        """Start the run's Execution once every robot reported; UNKNOWN_ROBOTS after a wait."""
+    def _start(self, run: Run, state: FleetState, now: int) -> Execution | None:
+        """
+        Start the run's Execution once every robot reported; UNKNOWN_ROBOTS after a wait.
+
+        Return the started Execution, or None while waiting (or once refused).
+        """
         settings, plan = self._settings, run.plan
         if state.stale:
             if now - run.requested_ns > settings.discovery_timeout * 1e9:
@@ -314,17 +317,17 @@ class PlanExecutor(Node):
                              '(topics %s)' % (settings.discovery_timeout, ', '.join(state.stale),
                                               ', '.join(self.resolve_topic_name(n + '/odom')
                                                         for n in state.stale)))
-            return False
-        run.execution = Execution(plan.reference, plan.tolerance, settings.execution,
-                                  plan.bodies)
+            return None
+        execution = Execution(plan.reference, plan.tolerance, settings.execution, plan.bodies)
+        run.execution = execution
         run.started_ns = run.last_ns = now
         self.get_logger().info('executing plan %d: %d robots, %.3f s (%.3f s as timed for '
                                'the robots)' % (plan.plan_id, len(plan.names),
                                                 plan.reference.duration,
-                                                run.execution.reference.duration))
-        return True
+                                                execution.reference.duration))
+        return execution
 
-    def _hold_expired(self, run: Run, state: FleetState, now: int) -> bool:
+    def _hold_expired(self, run: Run, plan_time: float, state: FleetState, now: int) -> bool:
         """End the goal ODOMETRY_LOST once the clock held hold_timeout for stale odometry."""
         if not state.stale:
             run.stale_since = None
@@ -340,7 +343,7 @@ class PlanExecutor(Node):
                   'every robot was sent zero velocity'
                   % (', '.join(state.stale), self._settings.odom_timeout,
                      ', '.join(self.resolve_topic_name(n + '/odom') for n in state.stale),
-                     held, run.execution.plan_time, timeout))
+                     held, plan_time, timeout))
         return True
 
     def _log_stale(self, run: Run, state: FleetState, plan_time: float) -> None:

@@ -13,6 +13,7 @@ robot; its odometry carries its heading (yaw) and its body-frame twist.
 Nothing to do before teardown: a simulated robot without commands stops by itself.
 """
 
+import functools
 import sys
 from typing import Any
 
@@ -52,7 +53,7 @@ class FleetSim(Node):
         self._sideways_logged: set[int] = set()
         for i, name in enumerate(self._names):
             self.create_subscription(Twist, name + '/cmd_vel',
-                                     lambda msg, i=i: self._on_command(i, msg), COMMANDS)
+                                     functools.partial(self._on_command, i), COMMANDS)
             self._odometry.append(self.create_publisher(Odometry, name + '/odom', COMMANDS))
         self._states = self.create_publisher(PoseArray, 'robot_states', COMMANDS)
         self._gap = self.create_publisher(Float64, '~/min_gap', LATCHED)

@@ -40,6 +40,7 @@ threads joined before anything is destroyed):
 
 from collections.abc import Iterable
 from dataclasses import dataclass
+import functools
 import gc
 import sys
 import threading
@@ -59,7 +60,6 @@ from rclpy.subscription import Subscription
 from std_msgs.msg import UInt32
 from visualization_msgs.msg import MarkerArray
 
-from .. import core
 from ..core import PlanningError
 from ..ros import conversions
 from ..ros import publications
@@ -107,7 +107,7 @@ class PlannerNode(Node):
         self._plan_count = 0
         self._robot_states: RobotState | None = None
         self._odometry: dict[str, RobotOdometry] = {}
-        self._obstacles: ObstacleSet | None = None
+        self._obstacles: ObstacleSet  # from the parameters, two lines below
         self._node_parameters = NodeParameters(self, PLANNER, self._apply_parameters)
         self._settings: PlannerSettings = self._node_parameters.settings
         self._obstacles = self._parameter_obstacles(self._settings)
@@ -131,7 +131,7 @@ class PlannerNode(Node):
         # The executor sends the callback's reply through this attribute: through
         # _send_response, so that no reply is dropped without an error in the log.
         self._send = self._service.send_response
-        self._service.send_response = self._send_response
+        self._service.send_response = self._send_response  # type: ignore[method-assign]
         self._answering = 0  # the number of the request whose reply is being sent
         self._collecting = True  # whether the cyclic collector ran when it was taken
         self._after_reply: AfterReply | None = None  # what to publish once it is sent
@@ -178,8 +178,7 @@ class PlannerNode(Node):
         for name in names:
             if name not in self._odometry_subscriptions:
                 self._odometry_subscriptions[name] = self.inputs.create_subscription(
-                    Odometry, name + '/odom',
-                    lambda msg, name=name: self._on_odometry(name, msg), STATE)
+                    Odometry, name + '/odom', functools.partial(self._on_odometry, name), STATE)
 
     def _on_obstacles(self, msg: PoseArray) -> None:
         """Take a new obstacle set if it can be planned in; else warn and keep the old one."""
@@ -270,7 +269,7 @@ class PlannerNode(Node):
         number, outcome, response = after.number, after.outcome, after.outcome.response
         logger = self.get_logger()
         if outcome.ok:
-            p: core.Plan = outcome.plan  # ok: it has its plan
+            p = outcome.planned().plan
             logger.info('plan_sequence #%d: planned k=%d n=%d, domain %d of %d, clearance '
                         '%.6g, %.3f ms' % (number, p.positions.shape[1],
                                            len(p.waypoint_indices), p.domain_index,
@@ -339,9 +338,9 @@ class PlannerNode(Node):
                 'plan_sequence #%d: plan %d answered, but publishing it failed: %r; its '
                 'paths are retracted and it is not on plan' % (
                     after.number, after.outcome.plan_id, error))
-            self._retract(after.outcome.names, after.settings)
+            self._retract(after.outcome.names or [], after.settings)
 
-    def _publish(self, outcome, settings):
+    def _publish(self, outcome: Outcome, settings: PlannerSettings) -> None:
         """
         Publish the complete plan in the order of msg_docs/topics.md.
 
@@ -350,9 +349,9 @@ class PlannerNode(Node):
         """
         messages = publications.plan_messages(outcome, settings)
         publishers = [self._publisher(m.topic, m.msg_type) for m in messages]
-        planned = set(outcome.names)
-        stale = [name for name in self._latched_names if name not in planned]
-        paths = len(outcome.names)
+        names = outcome.planned().names
+        stale = [name for name in self._latched_names if name not in names]
+        paths = len(names)
         for publisher, message in zip(publishers[:paths], messages[:paths]):
             publisher.publish(message.data)
         for name in stale:
@@ -360,9 +359,9 @@ class PlannerNode(Node):
                 conversions.empty_path(settings.frame_id, outcome.start_ns))
         for publisher, message in zip(publishers[paths:], messages[paths:]):
             publisher.publish(message.data)
-        self._latched_names = list(outcome.names)
+        self._latched_names = list(names)
 
-    def _retract(self, names, settings):
+    def _retract(self, names: list[str], settings: PlannerSettings) -> None:
         """After a failed publish, latch empty paths so no robot keeps a partial plan."""
         try:
             for name in names:

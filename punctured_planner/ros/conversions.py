@@ -430,13 +430,14 @@ def plan_message(outcome: Outcome, settings: PlannerSettings) -> Plan:
     The bodies are the workspace's (robot radius, obstacles and their radii); the
     tracking tolerance is execution.tracking_tolerance(min_gap).
     """
-    # a successful Outcome has its plan, names and paths (Outcome's fields are Optional)
-    workspace = outcome.plan.workspace
+    planned = outcome.planned()
+    plan = planned.plan
+    workspace = plan.workspace
     obstacles = [Point(x=x, y=y, z=z) for x, y, z in
                  to_xyz(workspace.obstacles, settings.plane_z).reshape(-1, 3).tolist()]
-    min_gap = float(outcome.plan.min_gap)
-    return Plan(plan_id=int(outcome.plan_id), robot_names=list(outcome.names),
-                paths=list(outcome.paths), max_speed=float(outcome.max_speed),
+    min_gap = float(plan.min_gap)
+    return Plan(plan_id=int(outcome.plan_id), robot_names=list(planned.names),
+                paths=list(planned.paths), max_speed=float(outcome.max_speed),
                 max_acceleration=float(outcome.max_acceleration),
                 robot_radius=float(workspace.robot_radius), obstacles=obstacles,
                 obstacle_radii=np.asarray(workspace.obstacle_radii, dtype=float).tolist(),

@@ -43,6 +43,11 @@ class Lookup:
     code: int
     message: str = ''
 
+    @property
+    def runnable(self) -> KnownPlan | None:
+        """Return the plan a goal can run (code NONE), else None."""
+        return self.plan if self.code == Result.NONE else None
+
 
 class PlanStore:
     """The last PLAN_HISTORY plans by id, oldest first."""

@@ -45,13 +45,13 @@ def plan_messages(outcome: Outcome, settings: PlannerSettings) -> list[Publicati
     ``plan_markers``, ``domain_index``, then ``plan`` (the Plan message, last: an
     executor never sees a plan whose paths are not out).
     """
-    # a successful Outcome has its plan, names and Paths (Outcome's fields are Optional)
+    planned = outcome.planned()
     messages = [Publication('%s/plan' % name.strip('/'), Path, data)
-                for name, data in zip(outcome.names, outcome.paths.serialized)]
+                for name, data in zip(planned.names, planned.paths.serialized)]
     messages.append(Publication('plan_markers', MarkerArray, plan_markers(
-        outcome.plan, settings.frame_id, outcome.start_ns, settings.plane_z, outcome.names,
+        planned.plan, settings.frame_id, outcome.start_ns, settings.plane_z, planned.names,
         outcome.max_speed)))
-    messages.append(Publication('domain_index', UInt32, domain_index_message(outcome.plan)))
+    messages.append(Publication('domain_index', UInt32, domain_index_message(planned.plan)))
     plan = plan_message(outcome, settings)
     messages.append(Publication('plan', type(plan), plan))
     return messages

@@ -29,7 +29,6 @@ import numpy as np
 
 from .settings import PlannerSettings
 from .snapshot import Outcome
-from ..core import Plan
 
 _SEPARATOR = '=' * 80
 _PRIMITIVES = {'bool', 'byte', 'char', 'float32', 'float64', 'int8', 'uint8', 'int16',
@@ -42,10 +41,11 @@ def _share_prefixes(package: str) -> list[str]:
     prefixes = [p for p in os.environ.get('AMENT_PREFIX_PATH', '').split(os.pathsep) if p]
     try:
         module = importlib.import_module(package)
-        # <prefix>/lib/pythonX.Y/site-packages/<package>/__init__.py
-        here: str = os.path.dirname(os.path.abspath(module.__file__))
-        prefixes.append(os.path.dirname(os.path.dirname(os.path.dirname(
-            os.path.dirname(here)))))
+        if module.__file__ is not None:  # None for a namespace package (a source tree)
+            # <prefix>/lib/pythonX.Y/site-packages/<package>/__init__.py
+            here = os.path.dirname(os.path.abspath(module.__file__))
+            prefixes.append(os.path.dirname(os.path.dirname(os.path.dirname(
+                os.path.dirname(here)))))
     except ImportError:
         pass
     return prefixes
@@ -150,7 +150,8 @@ def write_mcap(path: str | os.PathLike[str], messages: Iterable[tuple[str, objec
                 channels[topic] = writer.register_channel(
                     topic=topic, message_encoding=MessageEncoding.CDR,
                     schema_id=schemas[type_name])
-            stamp = int(log_time_ns if np.ndim(log_time_ns) == 0 else log_time_ns[sequence])
+            stamp = int(log_time_ns if isinstance(log_time_ns, (int, np.integer))
+                        else log_time_ns[sequence])
             writer.add_message(channel_id=channels[topic], log_time=stamp,
                                publish_time=stamp, sequence=sequence,
                                data=message.serialized())
@@ -164,13 +165,14 @@ def write_mcap(path: str | os.PathLike[str], messages: Iterable[tuple[str, objec
 def record_plan(path: str | os.PathLike[str], outcome: Outcome,
                 settings: PlannerSettings) -> str | os.PathLike[str]:
     """Write a successful planning Outcome to an MCAP file (see the module docstring)."""
-    p: Plan = outcome.plan  # a success has its plan
+    planned = outcome.planned()
+    p = planned.plan
     metadata = {
         'domain_index': p.domain_index, 'domain_count': p.domain_count,
         'domain': p.domain, 'sequential_complexity': p.sequential_complexity or 0,
         'optimal': p.optimal, 'min_clearance': repr(float(p.min_clearance)),
         'variant': p.variant, 'frame_id': settings.frame_id,
-        'max_speed': outcome.max_speed, 'robots': ','.join(outcome.names),
+        'max_speed': outcome.max_speed, 'robots': ','.join(planned.names),
         'projection_counts': ','.join(str(int(c)) for c in p.projection_counts),
     }
     from .publications import plan_messages

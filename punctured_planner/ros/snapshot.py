@@ -8,12 +8,16 @@ request is planned against, and the :class:`Outcome` of a request.
 
 from dataclasses import dataclass
 from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .settings import PlannerSettings
 from ..core import ErrorCode
 from ..core import Plan
+
+if TYPE_CHECKING:  # conversions imports this module
+    from .conversions import Paths
 
 
 def format_stamp(ns: int) -> str:
@@ -81,13 +85,22 @@ class Snapshot:
         return '%s; %s' % (self.obstacles.describe(), state)
 
 
+@dataclass(frozen=True, eq=False)
+class Planned:
+    """What a planned request made: the core's plan, the robots' Paths and their names."""
+
+    plan: Plan
+    paths: 'Paths'
+    names: list[str]
+
+
 @dataclass
 class Outcome:
     """The answer to one request: the filled response and, on success, the plan."""
 
     response: Any
     plan: Plan | None = None
-    paths: list | None = None
+    paths: 'Paths | None' = None
     names: list[str] | None = None
     start_ns: int = 0
     max_speed: float = 0.0
@@ -100,6 +113,13 @@ class Outcome:
     def ok(self) -> bool:
         """Return whether the request was planned (error_code NONE)."""
         return self.response.error_code == ErrorCode.NONE
+
+    def planned(self) -> Planned:
+        """Return what a planned request made; ValueError for one that was not planned."""
+        if self.plan is None or self.paths is None or self.names is None:
+            raise ValueError('the request was not planned (error_code %d): no plan to publish'
+                             % self.response.error_code)
+        return Planned(self.plan, self.paths, self.names)
 
 
 @dataclass(frozen=True, eq=False)
