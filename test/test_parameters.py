@@ -40,16 +40,20 @@ def test_settings_validation_gives_reasons(values, words):
     [2.0, 1.0, 0.0, 1.0], [5.0, 5.0, 0.0, 1.0],
 ])
 def test_workspace_bounds_are_refused_exactly_where_the_core_refuses_them(values):
-    """One rule: the parameter's reason is the core's, with the parameter and its axes."""
+    """One rule: the parameter's reason is the core's, with the parameter, its axes, entries."""
     from punctured_planner.core import PlanningError
     from punctured_planner.core.walls import checked_bounds
+    from punctured_planner.ros.wording import WallNames
     flat = np.asarray(values)
     with pytest.raises(PlanningError) as core:
         checked_bounds(flat.reshape(-1, 2) if flat.size % 2 == 0 else flat, 2)
     with pytest.raises(ValueError) as parameter:
         PLANNER.settings({'workspace_bounds': values})
     reason = str(parameter.value)
-    assert reason.startswith('workspace_bounds [') and core.value.args[0] in reason
+    # the same template, its wall named by the parameter entry that sets it
+    assert reason.startswith('workspace_bounds [') and core.value.describe(WallNames()) in reason
+    if core.value.wall is not None:
+        assert '(workspace_bounds[%d])' % core.value.wall.index in reason, reason
     assert 'for dimension 2 (x_min, x_max, y_min, y_max)' in reason
 
 
