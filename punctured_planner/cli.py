@@ -14,12 +14,26 @@ would publish it.
 """
 
 import argparse
+from collections.abc import Callable
+from collections.abc import Sequence
 import contextlib
 import os
 import sys
 import time
+from typing import Any
+from typing import TYPE_CHECKING
 
 import yaml
+
+if TYPE_CHECKING:  # rclpy and the ros modules load only where a command needs them
+    from rclpy.action.client import ClientGoalHandle
+    from rclpy.client import Client
+    from rclpy.executors import Executor
+    from rclpy.node import Node
+    from rclpy.task import Future
+
+    from punctured_planner.ros.settings import PlannerSettings
+    from punctured_planner.ros.snapshot import Outcome
 
 EXIT_OK = 0
 EXIT_PLANNER_ERROR = 1
@@ -29,7 +43,7 @@ EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a tool stopped by Ctr
 EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, as a shell reports a tool whose reader went away
 
 
-def load_request(path):
+def load_request(path: str) -> Any:
     """Read a YAML request file (``-`` for standard input) into plain data."""
     if path == '-':
         return yaml.safe_load(sys.stdin)
@@ -37,14 +51,15 @@ def load_request(path):
         return yaml.safe_load(stream)
 
 
-def build_request(data):
+def build_request(data: Any) -> Any:
     """Return a PlanSequence.Request filled from plain data (the ros2 YAML shape)."""
     from punctured_planner.ros.msg_dict import fill_message
     from punctured_planner_interfaces.srv import PlanSequence
     return fill_message(PlanSequence.Request(), data)
 
 
-def call_service(executor, client, request, timeout_sec):
+def call_service(executor: 'Executor', client: 'Client', request: Any,
+                 timeout_sec: float) -> Any | None:
     """
     Call ``client`` once; return the response, or None on timeout.
 
@@ -62,7 +77,7 @@ def call_service(executor, client, request, timeout_sec):
     return future.result()
 
 
-def spin_until(executor, predicate, timeout_sec):
+def spin_until(executor: 'Executor', predicate: Callable[[], bool], timeout_sec: float) -> bool:
     """Spin ``executor`` (spin_once) until predicate() is true; return whether it became so."""
     deadline = time.monotonic() + timeout_sec
     while not predicate():
@@ -86,7 +101,7 @@ class GoalWatch:
         """Start with no feedback heard."""
         self.last_feedback: float | None = None  # time.monotonic()
 
-    def heard(self, feedback) -> None:
+    def heard(self, feedback: Any) -> None:
         """Feedback callback of send_goal_async: the executor is alive now."""
         self.last_feedback = time.monotonic()
 
@@ -97,8 +112,8 @@ class GoalWatch:
         return time.monotonic() - self.last_feedback
 
 
-def wait_for_result(executor, handle, watch: GoalWatch, timeout_sec: float,
-                    silence_sec: float = FEEDBACK_SILENCE_SEC):
+def wait_for_result(executor: 'Executor', handle: 'ClientGoalHandle', watch: GoalWatch,
+                    timeout_sec: float, silence_sec: float = FEEDBACK_SILENCE_SEC) -> Any | None:
     """
     Spin until the goal's result; return it, or None when the executor went away.
 
@@ -162,7 +177,8 @@ def _call(args):
         return print_response(response, args.no_paths)
 
 
-def reset_obstacles(node, executor, planner_node, timeout_sec):
+def reset_obstacles(node: 'Node', executor: 'Executor', planner_node: str,
+                    timeout_sec: float) -> str | None:
     """
     Make a running planner go back to its obstacles parameter; return an error text or None.
 
@@ -177,7 +193,7 @@ def reset_obstacles(node, executor, planner_node, timeout_sec):
     if not remote.wait_for_services(timeout_sec=timeout_sec):
         return 'parameter services of %s not available' % planner_node
 
-    def wait(future):
+    def wait(future: 'Future') -> Any | None:
         deadline = time.monotonic() + timeout_sec
         while not future.done() and time.monotonic() < deadline:
             executor.spin_once(timeout_sec=0.1)
@@ -206,7 +222,7 @@ def _reset(args):
     return EXIT_OK
 
 
-def print_response(response, no_paths=False):
+def print_response(response: Any, no_paths: bool = False) -> int:
     """Print a PlanSequence response as YAML (code name on stderr); return the exit code."""
     from punctured_planner.ros.msg_dict import constant_names
     from punctured_planner.ros.msg_dict import message_to_dict
@@ -226,7 +242,8 @@ def print_response(response, no_paths=False):
     return EXIT_OK
 
 
-def offline_plan(request, settings, now_ns=None):
+def offline_plan(request: Any, settings: 'PlannerSettings',
+                 now_ns: int | None = None) -> 'Outcome':
     """
     Answer a PlanSequence request without a ROS graph; return the planning Outcome.
 
@@ -268,7 +285,8 @@ def _plan(args):
     if not outcome.ok:
         return code
     title = os.path.basename(args.request) if args.request != '-' else None
-    written = render_outputs(args, outcome.plan, title=title, max_speed=outcome.max_speed)
+    written = render_outputs(args, outcome.planned().plan, title=title,
+                             max_speed=outcome.max_speed)
     if args.mcap:
         written.append(record_plan(args.mcap, outcome, settings))
     for path in written:
@@ -276,7 +294,7 @@ def _plan(args):
     return code
 
 
-def make_parser(pictures=True):
+def make_parser(pictures: bool = True) -> argparse.ArgumentParser:
     """
     Return the argument parser of ``punctured-planner``.
 
@@ -326,7 +344,7 @@ def make_parser(pictures=True):
     return parser
 
 
-def main(argv=None):
+def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``punctured-planner`` console script."""
     argv = sys.argv[1:] if argv is None else list(argv)
     args = make_parser(pictures=argv[:1] == ['plan']).parse_args(argv)

@@ -20,12 +20,17 @@ Ctrl-C stops everything cleanly. Exit 0 when the plan was executed, 1 otherwise.
 """
 
 import argparse
+from collections.abc import Callable
+from collections.abc import Sequence
 import os
 import signal
 import subprocess
 import sys
 import tempfile
 import time
+from typing import Any
+from typing import cast
+from typing import TYPE_CHECKING
 
 import numpy as np
 import yaml
@@ -35,6 +40,9 @@ from .cli import GoalWatch
 from .cli import spin_until
 from .cli import wait_for_result
 
+if TYPE_CHECKING:  # ROS message types load with rclpy, in Recorder
+    from nav_msgs.msg import Odometry
+
 CONFIG = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), 'config')
 NODES = ('fleet_sim', 'planner_node', 'plan_executor')
 
@@ -42,7 +50,7 @@ NODES = ('fleet_sim', 'planner_node', 'plan_executor')
 class Recorder:
     """A client node that records what the demo needs, with arrival times."""
 
-    def __init__(self, names):
+    def __init__(self, names: list[str]) -> None:
         """Create the node, its executor and subscriptions (in /demo)."""
         import rclpy
         from geometry_msgs.msg import PoseStamped
@@ -58,11 +66,11 @@ class Recorder:
         self.executor = SingleThreadedExecutor()
         self.executor.add_node(self.node)
         self.names = names
-        self.messages = []   # (topic, message, arrival ns)
-        self.gap = []
-        self.odometry = {}
+        self.messages: list[tuple[str, Any, int]] = []   # (topic, message, arrival ns)
+        self.gap: list[float] = []
+        self.odometry: dict[str, Odometry] = {}
 
-        def keep(topic):
+        def keep(topic: str) -> Callable[[Any], None]:
             return lambda msg: self.messages.append(
                 (topic, msg, self.node.get_clock().now().nanoseconds))
 
@@ -76,19 +84,20 @@ class Recorder:
             self.node.create_subscription(Twist, name + '/cmd_vel',
                                           keep('/demo/%s/cmd_vel' % name), 50)
         self.node.create_subscription(Float64, 'fleet_sim/min_gap',
-                                      lambda msg: self.gap.append(msg.data), LATCHED)
+                                      lambda msg: self.gap.append(cast(Float64, msg).data),
+                                      LATCHED)
 
     def _odometry(self, name, keep):
-        def callback(msg):
+        def callback(msg: 'Odometry') -> None:
             self.odometry[name] = msg
             keep(msg)
         return callback
 
-    def spin(self, predicate, timeout_sec):
+    def spin(self, predicate: Callable[[], bool], timeout_sec: float) -> bool:
         """Spin until predicate() or the timeout; return whether it became true."""
         return spin_until(self.executor, predicate, timeout_sec)
 
-    def close(self):
+    def close(self) -> None:
         """Destroy the node and shut rclpy down."""
         import rclpy
         self.executor.shutdown()
@@ -260,7 +269,7 @@ def _with_drive(params_path, drive, folder):
     return path
 
 
-def main(argv=None):
+def main(argv: Sequence[str] | None = None) -> int:
     """Run the demo; return 0 when the plan was executed."""
     parser = argparse.ArgumentParser(description='From plan to motion with a simulated fleet.')
     parser.add_argument('--params', default=os.path.join(CONFIG, 'demo.yaml'))
@@ -278,10 +287,11 @@ def main(argv=None):
     logs = tempfile.mkdtemp(prefix='punctured_planner_demo_')
     bin_dir = os.path.dirname(sys.executable)
     params = args.params if args.drive is None else _with_drive(args.params, args.drive, logs)
+    log_files = [open(os.path.join(logs, name + '.log'), 'wb') for name in NODES]
     processes = [subprocess.Popen(
         [os.path.join(bin_dir, name), '--ros-args', '-r', '__ns:=/demo', '--params-file',
-         params], stdout=open(os.path.join(logs, name + '.log'), 'wb'),
-        stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL) for name in NODES]
+         params], stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
+        for name, log in zip(NODES, log_files)]
     print('started %s (logs in %s)' % (', '.join(NODES), logs))
     recorder = None
     code = 1
@@ -295,11 +305,14 @@ def main(argv=None):
             recorder.close()
         for process in processes:
             process.send_signal(signal.SIGINT)
-        for name, process in zip(NODES, processes):
+        for process in processes:
             try:
                 process.wait(timeout=15)
             except subprocess.TimeoutExpired:
                 process.kill()
+                process.wait()
+        for log in log_files:
+            log.close()
     return code
 
 

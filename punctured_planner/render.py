@@ -11,8 +11,11 @@ command of ``punctured-planner`` gets ``--png``/``--gif`` with two lines::
 """
 
 import argparse
+from collections.abc import Sequence
+import os
 import sys
 
+from .core import Plan
 from .viz import domain_picture, example_plan, render_animation, render_png
 
 
@@ -34,7 +37,7 @@ def _gif_path(text):
     return text
 
 
-def add_render_arguments(parser):
+def add_render_arguments(parser: argparse.ArgumentParser) -> argparse._ArgumentGroup:
     """Add --png, --dpi, --raw, --gif, --gif-fps, --gif-seconds and --gif-dpi to a parser."""
     group = parser.add_argument_group('pictures')
     group.add_argument('--png', metavar='OUT.png',
@@ -54,9 +57,10 @@ def add_render_arguments(parser):
     return group
 
 
-def render_outputs(args, plan, title=None, max_speed=1.0):
+def render_outputs(args: argparse.Namespace, plan: Plan, title: str | None = None,
+                   max_speed: float = 1.0) -> list[str | os.PathLike[str]]:
     """Write the pictures asked for by add_render_arguments' options; return their paths."""
-    written = []
+    written: list[str | os.PathLike[str]] = []
     if getattr(args, 'png', None):
         written.append(render_png(plan, args.png, title=title, dpi=args.dpi,
                                   raw=getattr(args, 'raw', False)))
@@ -81,7 +85,7 @@ def _example(args):
     return 0 if paths else 2
 
 
-def make_parser():
+def make_parser() -> argparse.ArgumentParser:
     """Return the parser of ``python -m punctured_planner.render``."""
     parser = argparse.ArgumentParser(prog='python -m punctured_planner.render',
                                      description='Draw pictures of the planner.')
@@ -101,7 +105,7 @@ def make_parser():
     return parser
 
 
-def main(argv=None):
+def main(argv: Sequence[str] | None = None) -> int:
     """Run ``python -m punctured_planner.render``; return the exit status."""
     args = make_parser().parse_args(argv)
     return args.func(args)

@@ -51,7 +51,7 @@ from nav_msgs.msg import Odometry
 from nav_msgs.msg import Path
 import numpy as np
 import numpy.typing as npt
-from punctured_planner_interfaces.msg import Plan  # type: ignore[attr-defined]
+from punctured_planner_interfaces.msg import Plan
 from punctured_planner_interfaces.srv import PlanSequence
 from std_msgs.msg import Header
 from std_msgs.msg import UInt32

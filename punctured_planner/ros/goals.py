@@ -11,7 +11,7 @@ from collections import OrderedDict
 from dataclasses import dataclass
 
 import numpy as np
-from punctured_planner_interfaces.action import ExecutePlan  # type: ignore[attr-defined]
+from punctured_planner_interfaces.action import ExecutePlan
 
 from .snapshot import RobotOdometry
 from ..execution import Bodies

@@ -8,7 +8,9 @@ never meet.
 """
 
 import os
+from typing import cast
 
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle
 import numpy as np
@@ -17,6 +19,7 @@ from PIL import Image
 from .canvas import robot_colours
 from .geometry import plane_view
 from .picture import plan_figure, plan_title
+from ..core import Plan
 from ..core.timing import leg_at
 
 
@@ -29,7 +32,8 @@ def _allocate(durations, budget):
     return counts
 
 
-def frame_parameters(plan, frame_count, max_speed=1.0):
+def frame_parameters(plan: Plan, frame_count: int,
+                     max_speed: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
     """
     Return (tau (F,), seconds (F,)) of the frames: time-uniform, every breakpoint kept.
 
@@ -88,7 +92,7 @@ class _Movers:
             self.trails.append(trail)
             self.robots.append(robot)
 
-    def update(self, history):
+    def update(self, history: np.ndarray) -> None:
         """Show the robots at history[-1] and their trails over history (F, k, 2 or 3)."""
         for robot, (trail, marker) in enumerate(zip(self.trails, self.robots)):
             points = history[:, robot]
@@ -125,7 +129,9 @@ def _static_background(figure, dynamic):
     return background
 
 
-def render_animation(plan, path, fps=20, seconds=8.0, dpi=80, title=None, max_speed=1.0):
+def render_animation(plan: Plan, path: str | os.PathLike[str], fps: float = 20,
+                     seconds: float = 8.0, dpi: float = 80, title: str | None = None,
+                     max_speed: float = 1.0) -> str | os.PathLike[str]:
     """
     Write the motion as an animated GIF at path (about fps * seconds frames); return path.
 
@@ -143,7 +149,7 @@ def render_animation(plan, path, fps=20, seconds=8.0, dpi=80, title=None, max_sp
     figure, axes = plan_figure(plan, dpi=dpi, title=title, path_alpha=0.25, arrows=False)
     heading = plan_title(plan, title)
 
-    def caption(frame):
+    def caption(frame: int) -> str:
         """Return the title of one frame: the plan's title, the time and the leg."""
         return (f'{heading}\nt = {stamps[frame]:.2f} s at {max_speed:g} m/s '
                 f'(tau {tau[frame]:.3f}), {_leg_label(plan, tau[frame])}')
@@ -159,7 +165,7 @@ def render_animation(plan, path, fps=20, seconds=8.0, dpi=80, title=None, max_sp
     background = _static_background(figure, dynamic)
     frames = []
     for frame in range(tau.size):
-        figure.canvas.restore_region(background)
+        cast(FigureCanvasAgg, figure.canvas).restore_region(background)  # new_figure's Agg canvas
         for mover, points in movers:
             mover.update(points[:frame + 1])
         heading_text.set_text(caption(frame))

@@ -9,9 +9,11 @@ obstacle gap), where all n k + 1 domains appear: open cells, lines, crossings.
 The lower strata are lines and points; they are drawn thickened to be seen.
 """
 
+import os
+
 import matplotlib
 from matplotlib.cm import ScalarMappable
-from matplotlib.colors import BoundaryNorm, ListedColormap
+from matplotlib.colors import BoundaryNorm, Colormap, ListedColormap
 import numpy as np
 from scipy.ndimage import binary_dilation
 
@@ -28,7 +30,7 @@ PLANE_REQUEST = [[[-3.3, 1.0], [1.2, -1.4]], [[1.0, 2.0], [3.0, -2.0]]]
 SLICE_REQUEST = [[[0.0, 1.0], [2.0, -1.0]], [[0.0, 1.5], [2.0, -1.5]]]
 
 
-def teaching_scene(robot_count):
+def teaching_scene(robot_count: int) -> tuple[Workspace, np.ndarray, np.ndarray]:
     """Return (workspace, plane request, slice request) for 1 or 2 robots."""
     if robot_count not in (1, 2):
         raise ValueError('the domain picture is drawn for 1 or 2 robots')
@@ -38,7 +40,7 @@ def teaching_scene(robot_count):
     return workspace, plane, sliced
 
 
-def thicken(values, width=2):
+def thicken(values: np.ndarray, width: int = 2) -> np.ndarray:
     """
     Return a copy of a domain image where each lower value is dilated to be visible.
 
@@ -54,7 +56,7 @@ def thicken(values, width=2):
     return shown
 
 
-def domain_colours(low, high):
+def domain_colours(low: int, high: int) -> tuple[Colormap, BoundaryNorm]:
     """Return (colormap, norm) with one discrete colour per domain value low..high."""
     palette = matplotlib.colormaps['viridis'].resampled(high - low + 1)
     colours = ListedColormap(palette(np.arange(high - low + 1))).with_extremes(bad='white')
@@ -101,7 +103,8 @@ def _slice_panel(ax, workspace, request, resolution, colours, norm):
     ax.set_ylabel('x of robot 0 in C_2')
 
 
-def domain_picture(path, robot_count=1, resolution=361, dpi=100):
+def domain_picture(path: str | os.PathLike[str], robot_count: int = 1, resolution: int = 361,
+                   dpi: float = 100) -> str | os.PathLike[str]:
     """Draw the domain picture for robot_count (1 or 2) robots into a PNG at path; return path."""
     workspace, plane, sliced = teaching_scene(robot_count)
     r = workspace.obstacle_count

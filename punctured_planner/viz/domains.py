@@ -10,13 +10,17 @@ strata are lines and points, so every grid axis contains the special values
 (where robot 0 shares a projection with an obstacle or another robot) exactly.
 """
 
-import numpy as np
+from collections.abc import Sequence
 
+import numpy as np
+import numpy.typing as npt
+
+from ..core import Workspace
 from ..core.pairs import point_pairs
 from ..core.strata import projection_count, projection_gaps
 
 
-def snapped_axis(low, high, count, special=()):
+def snapped_axis(low: float, high: float, count: int, special: npt.ArrayLike = ()) -> np.ndarray:
     """
     Return count evenly spaced values in [low, high], the nearest moved onto each special value.
 
@@ -41,7 +45,7 @@ def _invalid(configurations, obstacles):
     return bad
 
 
-def domain_values(workspace, configurations):
+def domain_values(workspace: Workspace, configurations: npt.ArrayLike) -> np.ndarray:
     """Return the domain l of every request in configurations (..., n, k, d); NaN if refused."""
     configurations = np.asarray(configurations, dtype=float)
     projections = workspace.frame.project(configurations)
@@ -51,7 +55,9 @@ def domain_values(workspace, configurations):
     return values
 
 
-def start_plane_grid(workspace, configurations, xs, ys):
+def start_plane_grid(workspace: Workspace, configurations: npt.ArrayLike,
+                     xs: Sequence[float] | np.ndarray,
+                     ys: Sequence[float] | np.ndarray) -> np.ndarray:
     """Return (len(ys), len(xs)) domains with robot 0 of C_1 at (x, y), all else fixed (d = 2)."""
     base = np.asarray(configurations, dtype=float)
     grid = np.broadcast_to(base, (len(ys), len(xs)) + base.shape).copy()
@@ -60,7 +66,9 @@ def start_plane_grid(workspace, configurations, xs, ys):
     return domain_values(workspace, grid)
 
 
-def start_goal_grid(workspace, configurations, starts, goals):
+def start_goal_grid(workspace: Workspace, configurations: npt.ArrayLike,
+                    starts: Sequence[float] | np.ndarray,
+                    goals: Sequence[float] | np.ndarray) -> np.ndarray:
     """
     Return (len(goals), len(starts)) domains of two-configuration requests C_1, C_2.
 
@@ -79,7 +87,7 @@ def start_goal_grid(workspace, configurations, starts, goals):
     return domain_values(workspace, grid)
 
 
-def start_goal_specials(workspace, configurations):
+def start_goal_specials(workspace: Workspace, configurations: npt.ArrayLike) -> list[np.ndarray]:
     """Return, per configuration, robot 0's x values where some robot meets an obstacle's x."""
     base = np.asarray(configurations, dtype=float)
     offsets = base[:, :, 0] - base[:, :1, 0]

@@ -7,18 +7,25 @@ arrows, obstacles (and their discs), numbered waypoints C_1..C_n (and the
 robots' discs there), the certified closest approach (smallest gap with radii).
 """
 
+from collections.abc import Sequence
+from typing import cast
+
+from matplotlib.axes import Axes
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, FancyArrowPatch
+from matplotlib.typing import ColorType
 import numpy as np
 
-from .geometry import closest_approach, extent, moving_legs, waypoints
+from .geometry import closest_approach, extent, moving_legs, PlaneView, waypoints
+from ..core import Plan
 
 AXIS_COLOUR = '0.35'
 CLEARANCE_COLOUR = 'crimson'
 ARROW_MIN_FRACTION = 0.03
 
 
-def draw_frame_lines(ax, plan, view, colours):
+def draw_frame_lines(ax: Axes, plan: Plan, view: PlaneView,
+                     colours: Sequence[ColorType]) -> None:
     """Draw the e1 axis (solid grey) and each robot's lane (dashed, in the robot's colour)."""
     axis = view(plan.axis_segment())
     ax.plot(axis[:, 0], axis[:, 1], color=AXIS_COLOUR, lw=1.2, zorder=1)
@@ -26,7 +33,8 @@ def draw_frame_lines(ax, plan, view, colours):
         ax.plot(lane[:, 0], lane[:, 1], ls='--', lw=0.8, color=colour, alpha=0.55, zorder=1)
 
 
-def draw_paths(ax, plan, view, colours, alpha=1.0, arrows=True):
+def draw_paths(ax: Axes, plan: Plan, view: PlaneView, colours: Sequence[ColorType],
+               alpha: float = 1.0, arrows: bool = True) -> None:
     """Draw each robot's polyline through the breakpoints, with an arrow on every long leg."""
     paths = view(plan.positions)
     minimum = ARROW_MIN_FRACTION * extent(paths)
@@ -43,15 +51,15 @@ def draw_paths(ax, plan, view, colours, alpha=1.0, arrows=True):
                                          lw=0, shrinkA=0, shrinkB=0, zorder=3))
 
 
-def draw_raw_paths(ax, plan, view, colours):
+def draw_raw_paths(ax: Axes, plan: Plan, view: PlaneView, colours: Sequence[ColorType]) -> None:
     """Draw the construction's own motion of a refined plan (Plan.raw) dashed, under it."""
-    paths = view(plan.raw.positions)
+    paths = view(cast(Plan, plan.raw).positions)  # a refined plan: its raw is set
     for robot, colour in enumerate(colours):
         ax.plot(paths[:, robot, 0], paths[:, robot, 1], ls='--', lw=0.9, color=colour,
                 alpha=0.6, zorder=1.5)
 
 
-def draw_obstacles(ax, plan, view, size=70):
+def draw_obstacles(ax: Axes, plan: Plan, view: PlaneView, size: float = 70) -> None:
     """Draw the obstacles as black crosses, and their discs where they have a radius."""
     obstacles = view(plan.workspace.obstacles)
     ax.scatter(obstacles[:, 0], obstacles[:, 1], marker='X', s=size, color='black', zorder=4)
@@ -60,7 +68,8 @@ def draw_obstacles(ax, plan, view, size=70):
             ax.add_patch(Circle((x, y), radius, fc='0.25', ec='black', alpha=0.5, zorder=3))
 
 
-def draw_waypoints(ax, plan, view, colours, size=12):
+def draw_waypoints(ax: Axes, plan: Plan, view: PlaneView, colours: Sequence[ColorType],
+                   size: float = 12) -> None:
     """Draw C_1..C_n as circles in each robot's colour, numbered 1..n, and the robots' discs."""
     radius = plan.workspace.robot_radius
     for m, configuration in enumerate(view(waypoints(plan))):
@@ -73,7 +82,7 @@ def draw_waypoints(ax, plan, view, colours, size=12):
                     color=colour, fontweight='bold', zorder=6)
 
 
-def draw_closest_approach(ax, plan, view):
+def draw_closest_approach(ax: Axes, plan: Plan, view: PlaneView) -> None:
     """Draw the certified closest approach as a dotted crimson segment."""
     points = closest_approach(plan)
     if points is None:
@@ -83,7 +92,8 @@ def draw_closest_approach(ax, plan, view):
     ax.plot(points[:, 0], points[:, 1], 'o', color=CLEARANCE_COLOUR, ms=3.5, zorder=7)
 
 
-def legend_handles(plan, colours, waypoints_numbered=True):
+def legend_handles(plan: Plan, colours: Sequence[ColorType],
+                   waypoints_numbered: bool = True) -> list[Line2D]:
     """Return proxy artists naming the robots and every layer of the picture."""
     handles = [Line2D([], [], color=colour, lw=2, label=f'robot {robot}')
                for robot, colour in enumerate(colours)]
@@ -102,7 +112,8 @@ def legend_handles(plan, colours, waypoints_numbered=True):
     return handles
 
 
-def draw_plan_2d(ax, plan, view, colours, path_alpha=1.0, arrows=True, raw=False):
+def draw_plan_2d(ax: Axes, plan: Plan, view: PlaneView, colours: Sequence[ColorType],
+                 path_alpha: float = 1.0, arrows: bool = True, raw: bool = False) -> None:
     """Draw every layer of the plan on ax, axes labelled by the view (raw: Plan.raw dashed)."""
     draw_frame_lines(ax, plan, view, colours)
     if raw and plan.raw is not None:

@@ -1,14 +1,20 @@
 """Draw a plan in a 3-D view (d = 3): the same layers as in the plane, on Axes3D."""
 
+from collections.abc import Sequence
+
+from matplotlib.typing import ColorType
+from mpl_toolkits.mplot3d import Axes3D
 import numpy as np
 
 from .draw2d import AXIS_COLOUR, CLEARANCE_COLOUR
 from .geometry import closest_approach, extent, moving_legs, waypoints
+from ..core import Plan
 
 ARROW_MIN_FRACTION = 0.04
 
 
-def draw_paths_3d(ax, plan, colours, alpha=1.0, arrows=True):
+def draw_paths_3d(ax: Axes3D, plan: Plan, colours: Sequence[ColorType], alpha: float = 1.0,
+                  arrows: bool = True) -> None:
     """Draw each robot's polyline and, on every long leg, a direction arrow (quiver)."""
     minimum = ARROW_MIN_FRACTION * extent(plan.positions)
     for robot, colour in enumerate(colours):
@@ -23,7 +29,8 @@ def draw_paths_3d(ax, plan, colours, alpha=1.0, arrows=True):
             ax.quiver(*tails.T, *vectors.T, color=colour, arrow_length_ratio=0.9, lw=1.4)
 
 
-def draw_plan_3d(ax, plan, colours, path_alpha=1.0, arrows=True):
+def draw_plan_3d(ax: Axes3D, plan: Plan, colours: Sequence[ColorType], path_alpha: float = 1.0,
+                 arrows: bool = True) -> None:
     """Draw axis, lanes, paths, obstacles, numbered waypoints and the closest approach."""
     axis = plan.axis_segment()
     ax.plot(*axis.T, color=AXIS_COLOUR, lw=1.2)

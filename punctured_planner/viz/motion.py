@@ -41,8 +41,9 @@ def render_motion(path: str, seconds: np.ndarray, positions: np.ndarray,
     if len(obstacles):
         ax.plot(obstacles[:, 0], obstacles[:, 1], 'kx', ms=8, mew=2)
     trails = [ax.plot([], [], color=colours[i], lw=2)[0] for i in range(k)]
-    discs = [ax.add_patch(Circle((0, 0), radius, color=colours[i], ec='black', zorder=5))
-             for i in range(k)]
+    discs = [Circle((0, 0), radius, color=colours[i], ec='black', zorder=5) for i in range(k)]
+    for disc in discs:
+        ax.add_patch(disc)
     heading = ax.set_title('')
     frames = []
     shown = np.unique(np.r_[np.searchsorted(seconds, np.arange(0.0, seconds[-1], 1.0 / fps)),
@@ -50,7 +51,7 @@ def render_motion(path: str, seconds: np.ndarray, positions: np.ndarray,
     for t in shown.tolist():
         for i in range(k):
             trails[i].set_data(positions[:t + 1, i, 0], positions[:t + 1, i, 1])
-            discs[i].center = positions[t, i]
+            discs[i].center = (float(positions[t, i, 0]), float(positions[t, i, 1]))
         heading.set_text('%s\nt = %.1f s, smallest gap so far %.3f m'
                          % (title, seconds[t], gaps[t]))
         figure.canvas.draw()

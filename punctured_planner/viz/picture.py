@@ -5,13 +5,19 @@ Planar plans (d = 2) are drawn as they are; d = 3 as a 3-D view beside a top
 view (x, y); d > 3 projected on the frame plane (e1, e2).
 """
 
+import os
+
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+
 from .canvas import new_figure, robot_colours
 from .draw2d import draw_plan_2d, legend_handles
 from .draw3d import draw_plan_3d
 from .geometry import plane_view
+from ..core import Plan
 
 
-def clearance_text(plan):
+def clearance_text(plan: Plan) -> str:
     """
     Return one line naming the certified clearance and where it is reached.
 
@@ -28,7 +34,7 @@ def clearance_text(plan):
             f'{plan.leg_names[clearance.leg]} leg, tau {clearance.tau:.3f})')
 
 
-def domain_text(plan):
+def domain_text(plan: Plan) -> str:
     """Return one line with the domain l, its range, its index and TC_n."""
     low, high = plan.domain_range
     complexity = plan.sequential_complexity
@@ -38,7 +44,7 @@ def domain_text(plan):
             f'of {plan.domain_count} domains (TC_n = {tc}{optimal})')
 
 
-def plan_title(plan, title=None):
+def plan_title(plan: Plan, title: str | None = None) -> str:
     """Return the title: optional first line, sizes and variant, domain, clearance."""
     n, k, d = plan.configurations.shape
     r = plan.workspace.obstacle_count
@@ -50,7 +56,8 @@ def plan_title(plan, title=None):
     return '\n'.join(lines)
 
 
-def plan_figure(plan, dpi=100, title=None, path_alpha=1.0, arrows=True, raw=False):
+def plan_figure(plan: Plan, dpi: float = 100, title: str | None = None, path_alpha: float = 1.0,
+                arrows: bool = True, raw: bool = False) -> tuple[Figure, list[Axes]]:
     """
     Return (figure, axes list) with the whole plan drawn; the caller saves or animates it.
 
@@ -82,7 +89,8 @@ def plan_figure(plan, dpi=100, title=None, path_alpha=1.0, arrows=True, raw=Fals
     return figure, axes
 
 
-def render_png(plan, path, title=None, dpi=100, raw=False):
+def render_png(plan: Plan, path: str | os.PathLike[str], title: str | None = None,
+               dpi: float = 100, raw: bool = False) -> str | os.PathLike[str]:
     """Draw the plan into a PNG file at path and return the path (raw: see plan_figure)."""
     figure, _ = plan_figure(plan, dpi=dpi, title=title, raw=raw)
     figure.savefig(path, dpi=dpi, format='png')
