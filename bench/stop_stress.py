@@ -14,6 +14,7 @@ same cycles (test/test_clean_stop.py, test/test_colcon_build.py).
     .venv/bin/python bench/stop_stress.py                        # 300 per install
     .venv/bin/python bench/stop_stress.py --cycles 20 --install venv
     .venv/bin/python bench/stop_stress.py --install colcon --workspace ws  # reuse a build
+    .venv/bin/python bench/stop_stress.py --install venv --cycles 20 --freeze-sec 0.5
 """
 
 import argparse
@@ -35,7 +36,8 @@ from stop_check import node_arguments  # noqa: E402
 from stop_check import run_cycle  # noqa: E402
 
 
-def stress(install, command, cycles, seed, cwd, env, client, caller, keep_dir):
+def stress(install, command, cycles, seed, cwd, env, client, caller, keep_dir,
+           freeze_sec=None):
     """Run the cycles of one install; print progress and the counts; return the failures."""
     rng = np.random.default_rng(seed)
     counts = collections.Counter()
@@ -44,7 +46,7 @@ def stress(install, command, cycles, seed, cwd, env, client, caller, keep_dir):
     for number in range(cycles):
         namespace = '/pp_stress_%s_%d_%d' % (install, os.getpid(), number)
         cycle = run_cycle(client, command(namespace), env, namespace, log_path,
-                          draw(rng), rng, caller, cwd=cwd)
+                          draw(rng), rng, caller, cwd=cwd, freeze_sec=freeze_sec)
         counts[cycle.signal_name] += 1
         counts['during a call'] += cycle.during_call
         counts['during a call, answered'] += cycle.during_call and cycle.answered
@@ -80,6 +82,10 @@ def main(argv=None):
     parser.add_argument('--install', choices=('venv', 'colcon', 'both'), default='both')
     parser.add_argument('--workspace', help='an already built colcon workspace to use')
     parser.add_argument('--seed', type=int, default=13)
+    parser.add_argument('--freeze-sec', type=float,
+                        help='freeze each caller from the moment the node takes its call '
+                             'until this long after the signal, which goes out after the '
+                             'reply (test/stop_check.py run_cycle)')
     args = parser.parse_args(argv)
     os.environ.setdefault('ROS_DOMAIN_ID', str(1 + (os.getpid() + 70) % 101))
     os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
@@ -97,7 +103,8 @@ def main(argv=None):
         if args.install in ('venv', 'both'):
             script = os.path.join(os.path.dirname(sys.executable), 'planner_node')
             failures += stress('venv', lambda ns: [script] + node_arguments(ns), args.cycles,
-                               args.seed, None, dict(os.environ), client, caller, keep_dir)
+                               args.seed, None, dict(os.environ), client, caller, keep_dir,
+                               args.freeze_sec)
         if args.install in ('colcon', 'both'):
             env = venv_env(os.environ)
             workspace = args.workspace or os.path.join(keep_dir, 'ws')
@@ -108,7 +115,8 @@ def main(argv=None):
                     return 1
             failures += stress(
                 'colcon', lambda ns: installed_node_command(workspace, node_arguments(ns)),
-                args.cycles, args.seed + 1, workspace, env, client, caller, keep_dir)
+                args.cycles, args.seed + 1, workspace, env, client, caller, keep_dir,
+                args.freeze_sec)
     finally:
         client.destroy_node()
         rclpy.try_shutdown(context=context)

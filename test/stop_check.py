@@ -128,7 +128,7 @@ def _wait_for_text(path, text, process, timeout_sec):
 
 
 def run_cycle(client_node, command, env, namespace, log_path, choice, rng, caller,
-              cwd=None):
+              cwd=None, freeze_sec=None):
     """
     Run one cycle of ``command`` (a planner_node in ``namespace``); return a Cycle.
 
@@ -138,7 +138,11 @@ def run_cycle(client_node, command, env, namespace, log_path, choice, rng, calle
     matched for the first time when the reply goes out. ``choice`` is (signal
     number, k, delay s) as :func:`draw` returns it: the signal goes out
     ``delay`` seconds after the node logged the request, whose k robots are
-    drawn from ``rng``.
+    drawn from ``rng``. With ``freeze_sec``, the caller is frozen (SIGSTOP) from
+    the moment the node took the call, so that it reads nothing while its reply
+    goes out; the signal goes out ``delay`` seconds after the node logged how the
+    call ended (the reply is written before), and the caller resumes
+    ``freeze_sec`` after the signal.
     """
     from punctured_planner_interfaces.srv import PlanSequence
     number, k, delay = choice
@@ -158,9 +162,15 @@ def run_cycle(client_node, command, env, namespace, log_path, choice, rng, calle
                           '--no-paths', '--timeout', str(CALL_TIMEOUT_SEC)],
                 env=env, stdout=call_log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
             taken = served and _wait_for_text(log_path, b'plan_sequence #1:', call, 30.0)
+            if freeze_sec is not None:
+                call.send_signal(signal.SIGSTOP)
+                _wait_for_text(log_path, b'plan_sequence #1: planned', process, 30.0)
             time.sleep(delay)
             during = taken and call.poll() is None
             process.send_signal(number)
+            if freeze_sec is not None:
+                time.sleep(freeze_sec)
+                call.send_signal(signal.SIGCONT)
             try:
                 returncode: Optional[int] = process.wait(STOP_TIMEOUT_SEC)
             except subprocess.TimeoutExpired:

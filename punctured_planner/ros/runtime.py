@@ -42,7 +42,8 @@ hung now and then, and segfaulted about once in 26 stops. Here instead:
    finishes its callback in flight and returns; the threads are joined. Only
    then are the executors shut down, the group's ``before_teardown`` hook run
    (plan_executor's last zero velocity), then the process lingers until
-   ``REPLY_GRACE_SEC`` after the last reply it wrote, and only then are the
+   ``REPLY_GRACE_SEC`` after the last reply it wrote (or until no client of
+   the services that replied is left), and only then are the
    nodes destroyed (in reverse order) and the Context shut down. Every step
    between the stop and the destruction lives in one place,
    :meth:`ExecutorThreads.close`, which :func:`run_nodes` and the in-process
@@ -55,12 +56,13 @@ goals; (2) what is in flight finishes: the plan call in flight writes its
 reply, each thread answers the service requests that had already arrived,
 and the hook ends the goal in flight while its thread spins on until the
 Future it returned is done (the result sent), at most ``STOP_DRAIN_SEC``, and
-``REPLY_GRACE_SEC`` more for a result request still on the wire;
+``REQUEST_GRACE_SEC`` more for a result request still on the wire;
 (3) the participant stays until ``REPLY_GRACE_SEC`` after the last reply
 written (a service's response or an action server's), so that the DDS writer
-can still deliver or resend it to a client that only just matched; (4)
-teardown. rclpy offers no acknowledgement of a service reply, so the linger
-is a bounded time after the write, not an observed delivery.
+can still resend it at its next heartbeat to a client that missed part of it,
+or until no client of the services that replied is left; (4) teardown. rclpy
+offers no acknowledgement of a service reply, so the linger is a bounded time
+after the write, not an observed delivery.
 
 A callback that raises stops the process the same way, with the traceback
 logged and exit code 1. A callback still running ``timeout_sec`` after the
@@ -78,6 +80,7 @@ import time
 import traceback
 from typing import Any
 from typing import Callable
+from typing import Dict
 from typing import List
 from typing import Optional
 from typing import Sequence
@@ -101,9 +104,18 @@ from .qos import SERVER_QOS
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 # Seconds a callback in flight may take to finish after the stop signal.
 STOP_TIMEOUT_SEC = 30.0
-# Seconds the participant stays after the last reply it wrote (step 3 of the stop):
-# enough for a reliable DDS writer to resend to a reader that matched late.
-REPLY_GRACE_SEC = 1.0
+# Seconds the participant stays after the last reply it wrote (step 3 of the stop),
+# unless no client of the services that replied is left: a reliable Fast DDS writer
+# resends what a reader missed at its periodic heartbeat, every 3 s by default, and a
+# reply larger than the writer's shared-memory segment (512 KB; a k = 512 plan is
+# 565 KB) that its reader was not reading when it went out arrives only then
+# (doc/design.md section 16).
+REPLY_GRACE_SEC = 4.0
+# Seconds between two looks at the graph while the participant stays.
+LINGER_POLL_SEC = 0.05
+# Seconds the first node's thread spins on after the goal in flight ended, for a
+# result request still on the wire.
+REQUEST_GRACE_SEC = 1.0
 # Seconds the first node's thread spins on after the stop for before_stop's Future.
 STOP_DRAIN_SEC = 2.0
 # What writes a reply when its callback runs: a service, an action server.
@@ -211,6 +223,11 @@ class ExecutorThreads:
         self._before_stop = before_stop
         self._stopping = threading.Event()
         self._last_reply: Optional[float] = None  # time.monotonic() after the last reply
+        # Who the linger waits for: the services that replied (name -> their node), and
+        # whether an action server replied (its clients are not counted: it waits the
+        # whole grace).
+        self._replied: Dict[str, Node] = {}
+        self._action_replied = False
         self._executors = []
         for node in self.nodes:
             executor = SingleThreadedExecutor(context=context)
@@ -248,15 +265,23 @@ class ExecutorThreads:
         """Run one ready callback; return False once ``condition()`` or the timeout came."""
         entity: object  # what the callback belongs to: a Service, a Timer, a waitable...
         try:
-            handler, entity, _ = executor.wait_for_ready_callbacks(
+            handler, entity, node = executor.wait_for_ready_callbacks(
                 timeout_sec=timeout_sec, condition=condition)
         except (ConditionReachedException, ShutdownException, TimeoutException):
             return False
         handler()
         if isinstance(entity, REPLYING):
-            self._last_reply = time.monotonic()
+            self._replied_by(entity, node)
         handler.result()  # raises the callback's exception
         return not condition()
+
+    def _replied_by(self, replier: object, node: Node) -> None:
+        """Note that ``replier`` (a Service or an ActionServer of ``node``) wrote a reply now."""
+        self._last_reply = time.monotonic()
+        if isinstance(replier, Service):
+            self._replied[replier.srv_name] = node
+        else:
+            self._action_replied = True
 
     def _answer_waiting(self, node: Node) -> None:
         """
@@ -274,11 +299,11 @@ class ExecutorThreads:
                 if header is None:
                     break
                 service.send_response(service.callback(request, srv_type.Response()), header)
-                self._last_reply = time.monotonic()
+                self._replied_by(service, node)
 
     def _drain(self, executor: SingleThreadedExecutor, ended: Optional[Future]) -> None:
         """
-        Spin on until ``ended`` is done (at most STOP_DRAIN_SEC), then REPLY_GRACE_SEC more.
+        Spin on until ``ended`` is done (at most STOP_DRAIN_SEC), then REQUEST_GRACE_SEC more.
 
         The grace spin answers a request about what just ended that was still on
         the wire when it ended: a client that asked for a goal's result just
@@ -296,7 +321,8 @@ class ExecutorThreads:
         while time.monotonic() < deadline and self._run_one(executor, _never, 0.0):
             pass
         self._last_reply = time.monotonic()
-        grace_end = self._last_reply + REPLY_GRACE_SEC
+        self._action_replied = True
+        grace_end = self._last_reply + REQUEST_GRACE_SEC
         while (remaining := grace_end - time.monotonic()) > 0.0:
             self._run_one(executor, _never, remaining)
 
@@ -325,12 +351,25 @@ class ExecutorThreads:
                 for node, thread in zip(self.nodes, self._threads) if thread.is_alive()]
 
     def linger(self, grace_sec: float = REPLY_GRACE_SEC) -> float:
-        """Sleep until ``grace_sec`` after the last reply written, if any; return the sleep."""
+        """
+        Wait until ``grace_sec`` after the last reply written, if any; return the wait.
+
+        The wait ends sooner once no client of the services that replied is left
+        (a one-shot caller such as ``ros2 service call`` has its reply and is gone),
+        unless an action server replied: its clients are not counted.
+        """
         if self._last_reply is None:
             return 0.0
-        remaining = max(0.0, self._last_reply + grace_sec - time.monotonic())
-        time.sleep(remaining)
-        return remaining
+        started = time.monotonic()
+        end = self._last_reply + grace_sec
+        while (remaining := end - time.monotonic()) > 0.0 and self._awaited():
+            time.sleep(min(remaining, LINGER_POLL_SEC))
+        return time.monotonic() - started
+
+    def _awaited(self) -> bool:
+        """Return whether a client may still be waiting for a reply written before the stop."""
+        return self._action_replied or any(
+            node.count_clients(name) > 0 for name, node in self._replied.items())
 
     def close(self, timeout_sec: float = STOP_TIMEOUT_SEC,
               before_teardown: Optional[Callable[[], None]] = None,
