@@ -114,7 +114,7 @@ def request_data(rng, k, n=CONFIGURATIONS):
         for configuration in request.configurations], 'max_speed': request.max_speed}
 
 
-def _wait_for_text(path, text, process, timeout_sec):
+def wait_for_text(path, text, process, timeout_sec):
     """Wait until the file at ``path`` holds ``text`` or ``process`` exited; return if it does."""
     deadline = time.monotonic() + timeout_sec
     while time.monotonic() < deadline:
@@ -161,10 +161,10 @@ def run_cycle(client_node, command, env, namespace, log_path, choice, rng, calle
                 caller + ['call', request_path, '--service', namespace + '/plan_sequence',
                           '--no-paths', '--timeout', str(CALL_TIMEOUT_SEC)],
                 env=env, stdout=call_log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
-            taken = served and _wait_for_text(log_path, b'plan_sequence #1:', call, 30.0)
+            taken = served and wait_for_text(log_path, b'plan_sequence #1:', call, 30.0)
             if freeze_sec is not None:
                 call.send_signal(signal.SIGSTOP)
-                _wait_for_text(log_path, b'plan_sequence #1: planned', process, 30.0)
+                wait_for_text(log_path, b'plan_sequence #1: planned', process, 30.0)
             time.sleep(delay)
             during = taken and call.poll() is None
             process.send_signal(number)

@@ -52,6 +52,7 @@ def test_colcon_build_from_a_clone(tmp_path, ros_env, ros_client):
             pkg / 'share' / 'ament_index' / 'resource_index' / 'packages' / 'punctured_planner',
             pkg / 'share' / 'punctured_planner' / 'package.xml',
             pkg / site / 'punctured_planner' / 'core' / '__init__.py',
+            pkg / site / 'punctured_planner' / 'ros' / 'fastdds_profile.xml',
             iface / 'share' / 'punctured_planner_interfaces' / 'srv' / 'PlanSequence.srv',
             iface / site / 'punctured_planner_interfaces' / 'srv' / '_plan_sequence.py'):
         assert path.exists(), path

@@ -17,7 +17,12 @@ oldest sample. So a client that does not take for as long as the node answers 10
 calls of other clients loses its own reply; the same depth bounds the requests
 waiting in the node's request reader, and the replies its writer keeps for
 repairs.
+
+``FASTDDS_PROFILE``: what the node processes' reliable writers do beyond the
+QoS above (their heartbeat period), loaded by :func:`load_fastdds_profile`.
 """
+
+import os
 
 from rclpy.qos import DurabilityPolicy
 from rclpy.qos import HistoryPolicy
@@ -52,3 +57,27 @@ def _service_qos(depth: int) -> QoSProfile:
 
 SERVER_QOS = _service_qos(SERVER_DEPTH)
 CLIENT_QOS = _service_qos(CLIENT_DEPTH)
+
+# The Fast DDS XML profile of the package's node processes: reliable writers send a
+# heartbeat every 100 ms (Fast DDS: 3 s), so that a reader that missed part of a
+# sample gets it resent as soon as it reads again (doc/design.md section 16).
+FASTDDS_PROFILE = os.path.join(os.path.dirname(os.path.abspath(__file__)),
+                               'fastdds_profile.xml')
+# Where Fast DDS (Jazzy: 2.14) looks for a profile file; a user's choice is kept.
+FASTDDS_PROFILE_VARIABLE = 'FASTRTPS_DEFAULT_PROFILES_FILE'
+# The rmw implementations that read it; none is set means rmw_fastrtps_cpp (Jazzy).
+FASTDDS_RMWS = ('', 'rmw_fastrtps_cpp', 'rmw_fastrtps_dynamic_cpp')
+
+
+def load_fastdds_profile() -> bool:
+    """
+    Point Fast DDS at FASTDDS_PROFILE for this process; return whether it was.
+
+    Call before ``rclpy.init``. Nothing changes when the process runs another rmw,
+    or when the user already set FASTDDS_PROFILE_VARIABLE.
+    """
+    if (os.environ.get(FASTDDS_PROFILE_VARIABLE)
+            or os.environ.get('RMW_IMPLEMENTATION', '') not in FASTDDS_RMWS):
+        return False
+    os.environ[FASTDDS_PROFILE_VARIABLE] = FASTDDS_PROFILE
+    return True

@@ -99,6 +99,7 @@ from rclpy.service import Service
 from rclpy.signals import SignalHandlerOptions
 from rclpy.task import Future
 
+from .qos import load_fastdds_profile
 from .qos import SERVER_QOS
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
@@ -406,6 +407,7 @@ def run_nodes(name: str, make_nodes: Callable[[Context], NodeGroup],
     Call it from the main thread.
     """
     with StopSignals() as signals:
+        load_fastdds_profile()
         context = Context()
         rclpy.init(args=args, context=context, signal_handler_options=SignalHandlerOptions.NO)
         try:
