@@ -69,15 +69,13 @@ FASTDDS_PROFILE_VARIABLE = 'FASTRTPS_DEFAULT_PROFILES_FILE'
 FASTDDS_RMWS = ('', 'rmw_fastrtps_cpp', 'rmw_fastrtps_dynamic_cpp')
 
 
-def load_fastdds_profile() -> bool:
+def load_fastdds_profile() -> None:
     """
-    Point Fast DDS at FASTDDS_PROFILE for this process; return whether it was.
+    Point Fast DDS at FASTDDS_PROFILE for this process.
 
     Call before ``rclpy.init``. Nothing changes when the process runs another rmw,
     or when the user already set FASTDDS_PROFILE_VARIABLE.
     """
-    if (os.environ.get(FASTDDS_PROFILE_VARIABLE)
-            or os.environ.get('RMW_IMPLEMENTATION', '') not in FASTDDS_RMWS):
-        return False
-    os.environ[FASTDDS_PROFILE_VARIABLE] = FASTDDS_PROFILE
-    return True
+    if (not os.environ.get(FASTDDS_PROFILE_VARIABLE)
+            and os.environ.get('RMW_IMPLEMENTATION', '') in FASTDDS_RMWS):
+        os.environ[FASTDDS_PROFILE_VARIABLE] = FASTDDS_PROFILE
