@@ -31,6 +31,8 @@ MAX_DELAY_SEC = 0.3
 # Seconds the fresh client process waits for its reply.
 CALL_TIMEOUT_SEC = 15.0
 OBSTACLES = '[-2.0, 0.5, 0.0, 0.0, -0.5, 0.0, 2.5, 0.0, 0.0]'
+# What ``punctured-planner call`` prints once it has a response.
+ANSWERED = b'# error_code'
 
 
 @dataclass
@@ -114,6 +116,12 @@ def request_data(rng, k, n=CONFIGURATIONS):
         for configuration in request.configurations], 'max_speed': request.max_speed}
 
 
+def caller_command(caller, request_path, service):
+    """Return the command of one ``punctured-planner call`` (``caller``) of ``service``."""
+    return caller + ['call', request_path, '--service', service, '--no-paths', '--timeout',
+                     str(CALL_TIMEOUT_SEC)]
+
+
 def wait_for_text(path, text, process, timeout_sec):
     """Wait until the file at ``path`` holds ``text`` or ``process`` exited; return if it does."""
     deadline = time.monotonic() + timeout_sec
@@ -158,9 +166,8 @@ def run_cycle(client_node, command, env, namespace, log_path, choice, rng, calle
         try:
             served = client.wait_for_service(timeout_sec=30.0)
             call = subprocess.Popen(
-                caller + ['call', request_path, '--service', namespace + '/plan_sequence',
-                          '--no-paths', '--timeout', str(CALL_TIMEOUT_SEC)],
-                env=env, stdout=call_log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
+                caller_command(caller, request_path, namespace + '/plan_sequence'), env=env,
+                stdout=call_log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
             taken = served and wait_for_text(log_path, b'plan_sequence #1:', call, 30.0)
             if freeze_sec is not None:
                 call.send_signal(signal.SIGSTOP)
@@ -187,6 +194,6 @@ def run_cycle(client_node, command, env, namespace, log_path, choice, rng, calle
     with open(log_path, 'rb') as stream:
         output = stream.read().decode('utf-8', 'replace')
     with open(call_log_path, 'rb') as stream:
-        answered = b'# error_code' in stream.read()
+        answered = ANSWERED in stream.read()
     return Cycle(signal.Signals(number).name, k, delay, served, during, answered, returncode,
                  output)
