@@ -251,7 +251,7 @@ class ExecutorThreads:
                 pass
             self._answer_waiting(node)
             if first and self._before_stop is not None:
-                self._drain(executor, self._before_stop())
+                self._drain(node, executor, self._before_stop())
         except ExternalShutdownException:
             pass  # the Context was shut down by someone else: nothing left to spin
         except BaseException as error:  # noqa: B902 - logged, then the process stops
@@ -272,15 +272,15 @@ class ExecutorThreads:
             return False
         handler()
         if isinstance(entity, REPLYING):
-            self._replied_by(entity, node)
+            self._replied_by(entity if isinstance(entity, Service) else None, node)
         handler.result()  # raises the callback's exception
         return not condition()
 
-    def _replied_by(self, replier: object, node: Node) -> None:
-        """Note that ``replier`` (a Service or an ActionServer of ``node``) wrote a reply now."""
+    def _replied_by(self, service: Optional[Service], node: Node) -> None:
+        """Note that ``service`` of ``node`` (None: an action server of it) wrote a reply now."""
         self._last_reply = time.monotonic()
-        if isinstance(replier, Service):
-            self._replied[replier.srv_name] = node
+        if service is not None:
+            self._replied[service.srv_name] = node
         else:
             self._action_replied = True
 
@@ -302,7 +302,8 @@ class ExecutorThreads:
                 service.send_response(service.callback(request, srv_type.Response()), header)
                 self._replied_by(service, node)
 
-    def _drain(self, executor: SingleThreadedExecutor, ended: Optional[Future]) -> None:
+    def _drain(self, node: Node, executor: SingleThreadedExecutor,
+               ended: Optional[Future]) -> None:
         """
         Spin on until ``ended`` is done (at most STOP_DRAIN_SEC), then REQUEST_GRACE_SEC more.
 
@@ -321,8 +322,7 @@ class ExecutorThreads:
         # own): run whatever is ready now, until nothing is.
         while time.monotonic() < deadline and self._run_one(executor, _never, 0.0):
             pass
-        self._last_reply = time.monotonic()
-        self._action_replied = True
+        self._replied_by(None, node)  # the goal's result
         grace_end = self._last_reply + REQUEST_GRACE_SEC
         while (remaining := grace_end - time.monotonic()) > 0.0:
             self._run_one(executor, _never, remaining)
