@@ -276,13 +276,14 @@ class ExecutorThreads:
         handler.result()  # raises the callback's exception
         return not condition()
 
-    def _replied_by(self, service: Optional[Service], node: Node) -> None:
-        """Note that ``service`` of ``node`` (None: an action server of it) wrote a reply now."""
-        self._last_reply = time.monotonic()
+    def _replied_by(self, service: Optional[Service], node: Node) -> float:
+        """Note that ``service`` of ``node`` (None: an action server) replied; return when."""
+        now = self._last_reply = time.monotonic()
         if service is not None:
             self._replied[service.srv_name] = node
         else:
             self._action_replied = True
+        return now
 
     def _answer_waiting(self, node: Node) -> None:
         """
@@ -322,8 +323,7 @@ class ExecutorThreads:
         # own): run whatever is ready now, until nothing is.
         while time.monotonic() < deadline and self._run_one(executor, _never, 0.0):
             pass
-        self._replied_by(None, node)  # the goal's result
-        grace_end = self._last_reply + REQUEST_GRACE_SEC
+        grace_end = self._replied_by(None, node) + REQUEST_GRACE_SEC  # after the goal's result
         while (remaining := grace_end - time.monotonic()) > 0.0:
             self._run_one(executor, _never, remaining)
 
