@@ -108,9 +108,9 @@ def _room(fleet, workspace, unwalled, side) -> Room:
     corners = np.stack(np.meshgrid(*workspace.bounds, indexing='ij'), axis=-1).reshape(-1, 2)
     room = float(frame.offset(corners).max()) - RADIUS - layout.top
     width = float(np.ptp(frame.project(corners))) - 2 * RADIUS
-    risen = max(float((h + rise(p, h, layout).lift[-1]).max())
-                for p, h in zip(frame.project(fleet.configurations),
-                                frame.offset(fleet.configurations)))
+    risen = max(float((h + rise(p, h, layout, layout.reaches(c)).lift[-1]).max())
+                for c, p, h in zip(fleet.configurations, frame.project(fleet.configurations),
+                                   frame.offset(fleet.configurations)))
     lanes = float(unwalled.lanes.max())
     return Room(room / side, (risen - layout.top) / side, (lanes - layout.top) / side,
                 width / side, (fleet.k - 1) * layout.pitch / side)

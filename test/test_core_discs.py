@@ -79,6 +79,43 @@ def test_balls_keep_the_margin_when_the_condition_holds(count, pillar_count, rho
         assert keeps_margin(p), (refine, p.min_gap, p.gap, p.leg_names[p.gap.leg])
 
 
+def _balls_among_balls(rng, count, pillars, apart, clear):
+    """Return count ball centres in the 4 m cube, apart from each other, clear of pillars."""
+    points = np.zeros((0, 3))
+    while len(points) < count:
+        point = rng.uniform(0.0, 4.0, 3)
+        if (np.all(np.linalg.norm(points - point, axis=1) >= apart)
+                and np.all(np.linalg.norm(pillars - point, axis=1) >= clear)):
+            points = np.vstack([points, point])
+    return points
+
+
+@pytest.mark.parametrize('seed', range(8))
+def test_balls_pass_pillars_whose_shadows_meet_only_in_the_frames_plane(seed):
+    """
+    Ball pillars close in e1 and e2 but far apart across them push no robot both.
+
+    Each robot's reach of a pillar is what is left of w_j at its distance across
+    e1 and e2 (DiscLayout.reaches): with w_j for every robot, a robot beside one
+    pillar was pushed by the other into the first (4 - 5 of 10 realistic 3-D
+    fleets of 20 - 40 balls refused, gaps down to -0.25 m; here 6 of seeds 0 - 9).
+    """
+    rng = np.random.default_rng(seed)
+    pillars = np.array([[2.0, 2.0, 0.8], [2.1, 2.2, 3.2]])
+    workspace = Workspace(pillars, variant='discs', robot_radius=0.2, obstacle_radius=0.15)
+    layout = workspace.disc_layout
+    p, h = layout.pillar_projections, layout.pillar_offsets
+    # Pillars 0 and 1 break the plane's condition (c); only their distance across saves it.
+    assert abs(p[0] - p[1]) < layout.reach[0] + layout.reach[1] + layout.apart
+    assert abs(h[0] - h[1]) < layout.zone[0] + layout.zone[1] + layout.apart
+    assert len(layout.conflicting_pillars()) == 0
+    configurations = [_balls_among_balls(rng, 40, pillars, separation(workspace), 0.55)
+                      for _ in range(3)]
+    for refine in (False, True):
+        result = plan(workspace, configurations, refine=refine)
+        assert keeps_margin(result), (refine, result.min_gap, result.leg_names[result.gap.leg])
+
+
 @pytest.mark.parametrize('rho_over_radius', [0.5, 1.0, 1.5])
 @pytest.mark.parametrize('radius', [0.1, 0.25])
 @pytest.mark.parametrize('count', [2, 6, 12])
@@ -265,7 +302,7 @@ def test_the_rise_stacks_the_fleet_on_the_staging_height_unpushed(count):
     frame = layout.frame
     fleet[0] = frame.origin - side * frame.e1 + (layout.top + 15.0) * frame.e2  # far above top
     p, h = layout.frame.project(fleet), layout.frame.offset(fleet)
-    motion = rise(p, h, layout)
+    motion = rise(p, h, layout, layout.reaches(fleet))
     ends = h + motion.lift[-1]
     assert np.all(motion.shift[-1] == 0)
     assert np.all(np.diff(motion.lift, axis=0) >= 0)  # no robot ever moves down

@@ -8,7 +8,11 @@ offset and w_j = R + rho_j + mu_j for the reach of pillar j, where the passing
 margin mu_j = max(R, rho_j) / 10 keeps robots off every pillar they pass, as
 wide as it may be (w_j = min_spacing / 2 when both radii are 0, so point
 robots still keep off point obstacles), and nu = R / 10 is the margin kept
-between two robots.
+between two robots. For d >= 3 robot i meets pillar j with its own reach
+w_ij = sqrt(max(w_j^2 - c_ij^2, 0)), c_ij its distance to q_j across e1 and
+e2, which the rise keeps (DiscLayout.reaches): it keeps w_j from q_j exactly
+when it keeps w_ij from q_j's projection onto its plane through e1 and e2.
+Below, w_j, f_j and z_j are robot i's wherever a robot is pushed.
 
 A required gap c (required_clearance) is planned for by inflating R and every
 rho_j by c / 2 (Workspace.disc_layout): a gap >= 0 between the inflated bodies
@@ -73,7 +77,8 @@ is 4R when every rho_j <= 0.8R. Suppose in every configuration (a) robot
 centres are at least S apart, (b) no robot disc overlaps a pillar
 (|x - q_j| >= R + rho_j; validation refuses the rest), and (c) any two pillars
 j, l satisfy |p(q_j) - p(q_l)| >= w_j + w_l + 2R + nu or
-|h(q_j) - h(q_l)| >= z_j + z_l + 2R + nu. Then every gap of a robot and pillar
+|h(q_j) - h(q_l)| >= z_j + z_l + 2R + nu or (d >= 3) are w_j + w_l + 2R + nu
+apart across e1 and e2. Then every gap of a robot and pillar
 j stays >= min(mu_j, its gap in the configurations) and every gap of two
 robots >= nu: min_gap >= min(nu, g_C) with nu = R / 10, g_C the smallest
 robot-pillar gap of the configurations themselves (a robot touching a pillar
@@ -90,7 +95,8 @@ of the following.
 common rise, cut off at its stop above every zone. While |u| > w_j the e2
 distance exceeds w_j. While |u| <= w_j, the push of j alone puts the robot at
 e1 offset delta + lambda_j (w_j - delta) >= lambda_j w_j >= sqrt(w_j^2 - u^2)
-from p(q_j), so at distance >= w_j (gap >= mu_j); the sidestep moves a robot
+from p(q_j), so at distance >= w_j (gap >= mu_j; for d >= 3 the squared
+distance adds c_ij^2 to w_ij^2, which is the pillar's w_j^2); the sidestep moves a robot
 straight away from p(q_j), so its gap only grows from C's. Pushes of pillars on the
 same side only add to it. A pillar l on the other side pushes only while the
 robot is in its shadow and |u_l| < z_l, which puts l within w_j + w_l of
@@ -168,9 +174,11 @@ LIFT, SLIDE, DROP = 'lift', 'slide', 'drop'
 @dataclass(frozen=True, eq=False)
 class DiscLayout:
     """
-    What the construction fixes per workspace: the pillars in frame coordinates and pitches.
+    What the construction fixes per workspace: the pillars and pitches.
 
-    reach w_j, full-push and zone half-heights f_j, z_j per pillar, the staging
+    The pillars (r, d) and their projections and e2 offsets in the frame, reach
+    w_j and zone half-height z_j per pillar (for d >= 3 each robot's reach is
+    less, reaches), the staging
     height top (with pillars; without, each segment's staging_height), the least
     distance apart 2R + nu that every robot pair keeps, the pitch g of the slots
     and the lanes, and the stack's reach D_p and fade (stacked_heights; module
@@ -178,10 +186,10 @@ class DiscLayout:
     """
 
     frame: Frame
+    pillars: np.ndarray
     pillar_projections: np.ndarray
     pillar_offsets: np.ndarray
     reach: np.ndarray
-    full: np.ndarray
     zone: np.ndarray
     top: float
     apart: float
@@ -210,23 +218,50 @@ class DiscLayout:
         # The stack keeps the slots' pitch where it can; the fade is what condition (a)
         # allows for the least it must keep, sqrt 2 (2R + nu) (module docstring).
         fade = np.sqrt(max(separation ** 2 - 2.0 * apart ** 2, 0.0))
-        return cls(frame, frame.project(obstacles), offsets, reach, FULL * reach, ZONE * reach,
+        return cls(frame, obstacles, frame.project(obstacles), offsets, reach, ZONE * reach,
                    top, apart, pitch, np.sqrt(2.0) * pitch, float(fade))
+
+    def reaches(self, configuration: np.ndarray) -> np.ndarray:
+        """
+        Return (k, r) the reach of each pillar for each robot of configuration (k, d).
+
+        In the plane w_j. For d >= 3 the rise and the pushes move a robot along e1
+        and e2 only, so its distance c across them to pillar j stays, and it keeps
+        w_j from q_j exactly when it keeps sqrt(w_j^2 - c^2) from q_j's projection
+        onto its plane through e1 and e2: 0 (no shadow) for c >= w_j.
+        """
+        reach = np.broadcast_to(self.reach, (len(configuration), self.reach.size))
+        if self.frame.e1.size == 2:
+            return reach
+        across = np.linalg.norm(_across(configuration[:, None] - self.pillars[None], self.frame),
+                                axis=-1)
+        return np.sqrt(np.maximum(reach * reach - across * across, 0.0))
 
     def conflicting_pillars(self) -> np.ndarray:
         """
         Return the (c, 2) index pairs j < l of pillars that break condition (c).
 
         Condition (c): |p(q_j) - p(q_l)| >= w_j + w_l + 2R + nu or
-        |h(q_j) - h(q_l)| >= z_j + z_l + 2R + nu, z the zone half-heights.
+        |h(q_j) - h(q_l)| >= z_j + z_l + 2R + nu, z the zone half-heights, or (d >= 3)
+        the two are w_j + w_l + 2R + nu apart across e1 and e2 (then no robot near
+        one of them across those is pushed by the other).
         """
         first, second = np.triu_indices(self.reach.size, 1)
+        across = (np.linalg.norm(_across(self.pillars[first] - self.pillars[second],
+                                         self.frame), axis=-1)
+                  >= self.reach[first] + self.reach[second] + self.apart)
         wide = (np.abs(self.pillar_projections[first] - self.pillar_projections[second])
                 >= self.reach[first] + self.reach[second] + self.apart)
         tall = (np.abs(self.pillar_offsets[first] - self.pillar_offsets[second])
                 >= self.zone[first] + self.zone[second] + self.apart)
-        bad = ~(wide | tall)
+        bad = ~(wide | tall | across)
         return np.stack([first[bad], second[bad]], axis=1)
+
+
+def _across(vectors: np.ndarray, frame: Frame) -> np.ndarray:
+    """Return vectors (..., d) less their e1 and e2 parts: what lies across both."""
+    return (vectors - (vectors @ frame.e1)[..., None] * frame.e1
+            - (vectors @ frame.e2)[..., None] * frame.e2)
 
 
 @dataclass(frozen=True)
@@ -277,9 +312,12 @@ def stacked_heights(p: np.ndarray, h: np.ndarray, layout: DiscLayout) -> np.ndar
     return heights
 
 
-def rise(p: np.ndarray, h: np.ndarray, layout: DiscLayout) -> Rise:
+def rise(p: np.ndarray, h: np.ndarray, layout: DiscLayout, reach: np.ndarray) -> Rise:
     """
     Return the sidestep and rise of a configuration with projections p and offsets h (k,).
+
+    reach (k, r) is each pillar's for each robot (DiscLayout.reaches): pillar j pushes
+    robot i within reach[i, j] of p(q_j), with that reach's full push and zone.
 
     Robot i rises by min(s, s_i), s_i = G_i - h_i its stop (stacked_heights;
     top - h_min for all beyond STACKED_ROBOTS robots), for s from 0 to
@@ -295,8 +333,9 @@ def rise(p: np.ndarray, h: np.ndarray, layout: DiscLayout) -> Rise:
         stops = np.full(len(h), max(0.0, layout.top - float(h.min())))
     total = float(stops.max())
     signed = p[:, None] - layout.pillar_projections[None, :]
-    robots, pillars = np.nonzero(np.abs(signed) < layout.reach[None, :])
-    reach, full, zone = layout.reach[pillars], layout.full[pillars], layout.zone[pillars]
+    robots, pillars = np.nonzero(np.abs(signed) < reach)
+    reach = reach[robots, pillars]
+    full, zone = FULL * reach, ZONE * reach
     # Zone edges in s: u = h + s - h_q crosses -zone, -full, full, zone (all before the
     # robot's stop, which is above every zone).
     edges = (layout.pillar_offsets[pillars] - h[robots])[:, None] + np.stack(
@@ -390,7 +429,8 @@ def section(configurations: np.ndarray, layout: DiscLayout) -> DiscSection:
     projections = layout.frame.project(configurations)
     offsets = layout.frame.offset(configurations)
     for configuration, p, h in zip(configurations, projections, offsets):
-        risen = rise(p, h, layout).positions(configuration, layout.frame)
+        risen = rise(p, h, layout, layout.reaches(configuration)).positions(configuration,
+                                                                            layout.frame)
         names = [SIDESTEP] + [RISE] * (len(risen) - 2)
         rank = staging_ranks(p)
         # The gather moves along e1 only, into the slots' columns, at the risen heights.
