@@ -234,10 +234,16 @@ def _select(results, planner, d, ks):
             and r.fleet.k in ks and r.solved]
 
 
+def _apart(results):
+    """Return 'a/b': how many of the plans keep every pair of bodies apart (min_gap >= 0)."""
+    return f'{sum(r.gap >= 0 for r in results)}/{len(results)}'
+
+
 def table(results):
     """Return the rows per (d, k): medians of every figure for the three planners."""
     rows = [('d', 'k', 'plans', 'length ratio: construction, refined, OMPL',
              'excursion: construction, refined, OMPL', 'refined min_gap >= margin',
+             'bodies apart (min_gap >= 0): construction, refined',
              'time ms: construction, refined, OMPL (without its checker)',
              'continuity: construction, refined (max)')]
     for d in sorted({r.fleet.d for r in results}):
@@ -257,6 +263,7 @@ def table(results):
                 ', '.join([_median([r.excursion for r in group], 0, 100) + '%'
                            for group in (raw, refined, solved)]),
                 f'{kept}/{len(refined)}',
+                ', '.join(_apart(group) for group in (raw, refined)),
                 ', '.join([_median([r.seconds for r in raw], 1, 1e3),
                            _median([r.seconds for r in refined], 1, 1e3), ompl]),
                 ', '.join(f'{np.nanmax([r.continuity for r in group] + [np.nan]):.1f}'
@@ -288,6 +295,13 @@ def summary(results):
         f'{share(range(3, 41))}% (target <= 15%), k = 100 - 200 {share(large)}%.',
         f'- Refined plans with min_gap >= their margin: '
         f'{sum(r.gap >= r.margin for r in refined)} of {len(refined)} (target all).',
+        '- Bodies apart (min_gap >= 0), construction and refined: discs (d = 2) '
+        + ' and '.join(_apart([r for r in results if r.planner == planner and r.fleet.d == 2])
+                       for planner in (RAW, REFINED))
+        + ', balls (d = 3) '
+        + ' and '.join(_apart([r for r in results if r.planner == planner and r.fleet.d == 3])
+                       for planner in (RAW, REFINED))
+        + ' (doc/design.md section 6: each ball meets a pillar with its own reach).',
         f'- Planning time with the certificate, k = 40 n = 3: refined '
         f'{milliseconds(REFINED, 40)} ms (target < 50 ms), construction '
         f'{milliseconds(RAW, 40)} ms; k = 200: refined {milliseconds(REFINED, 200)} ms '
