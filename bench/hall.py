@@ -21,7 +21,8 @@ height the construction takes the fleet: its rise (core.discs.rise: the fleet
 stacked on the staging height) and its lanes (core.discs: about 2 sqrt k, a
 slot's pitch apart); and the staging line of k slots a pitch apart (its centres'
 span, (k - 1) g) against the room between the walls along e1 (their corners'
-extent along e1 less 2R: an upper bound, exact for an axis-aligned e1).
+extent along e1 less 2R). Both rooms are exact for an axis frame and upper bounds
+for an oblique one (the farthest corner, the corners' extent).
 
 Run alone: ``.venv/bin/python bench/hall.py [--quick]``.
 """

@@ -248,7 +248,9 @@ def test_a_plan_inside_its_walls_is_returned_and_one_outside_refused():
     roomy = wall_bounds(raw, 0.0, 0)
     roomy[:, 0] = np.minimum(roomy[:, 0], raw.positions.min(axis=(0, 1)) - 0.3)
     roomy[:, 1] = np.maximum(roomy[:, 1], raw.positions.max(axis=(0, 1)) + 0.3)
-    p = plan(Workspace(pillars, bounds=roomy, **options), [starts, goals])
+    # Walls around the raw motion, in its frame (theirs would be another one).
+    p = plan(Workspace(pillars, bounds=roomy, frame=raw.workspace.frame, **options),
+             [starts, goals])
     assert smallest_leg_slack(p.positions, roomy, 0.2).slack >= 0
     tight = np.array([[-0.3, 6.3], [-0.8, 3.8]])
     with pytest.raises(PlanningError) as caught:

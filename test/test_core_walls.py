@@ -315,17 +315,43 @@ def test_outside_workspace_ranks_beside_robot_on_obstacle_and_clearance_below_re
         max((judged - tight[:, 1]).max(), (tight[:, 0] - judged).max()))
 
 
-def test_the_walls_choose_the_axis_frame_with_the_most_room_beyond_the_obstacles():
-    """A pillar by the top wall: staging below the pillars fits where staging above cannot."""
+def test_the_walls_choose_an_oblique_frame_where_every_wall_has_a_pillar_by_it():
+    """
+    Pillars by the middle of every wall leave room only in the corners: e2 points to one.
+
+    Staging beyond the farthest pillar along any axis leaves the hall (each pillar
+    is 0.4 m from its wall), so every axis frame is refused; the frame the walls
+    choose (core.frame.choose_frame: the most area beyond the farthest pillar) is
+    diagonal, and its plan stays inside.
+    """
+    hall = np.array([[0.0, 6.0], [0.0, 6.0]])
+    pillars = np.array([[3.1, 5.6], [2.9, 0.4], [0.4, 3.2], [5.6, 2.8]])
+    configurations = np.array([[[2.0, 2.5], [3.0, 3.5], [4.0, 2.5]],
+                               [[4.0, 3.0], [2.0, 3.2], [3.0, 2.0]]])
+    bodies = {'variant': 'discs', 'robot_radius': 0.2, 'obstacle_radius': 0.15}
+    walled = Workspace(pillars, bounds=hall, **bodies)
+    assert np.all(np.abs(walled.frame.e2) > 0.5), walled.frame.e2
+    result = plan(walled, configurations)
+    assert (result.positions - 0.2 >= hall[:, 0]).all()
+    assert (result.positions + 0.2 <= hall[:, 1]).all()
+    for e1, e2 in (((1, 0), (0, 1)), ((1, 0), (0, -1)), ((0, 1), (1, 0)), ((0, 1), (-1, 0))):
+        axes = Workspace(pillars, bounds=hall, frame=((3.0, 3.0), e1, e2), **bodies)
+        with pytest.raises(PlanningError) as refused:
+            plan(axes, configurations)
+        assert refused.value.code == ErrorCode.OUTSIDE_WORKSPACE, (e1, e2)
+
+
+def test_the_walls_choose_the_frame_with_the_most_room_beyond_the_obstacles():
+    """A pillar by the top wall: staging away from it fits where staging above cannot."""
     hall = np.array([[0.0, 6.0], [0.0, 6.0]])
     pillars = np.array([[1.0, 5.3], [3.0, 2.0], [4.5, 3.0]])
     # Two robots low in the hall trade places: their projection order reverses.
     configurations = np.array([[[2.0, 0.8], [4.0, 0.8]], [[4.0, 1.2], [2.0, 1.2]]])
     bodies = {'variant': 'discs', 'robot_radius': 0.2, 'obstacle_radius': 0.15}
     walled = Workspace(pillars, bounds=hall, **bodies)
-    # Room along e2 = +y: 6 - 5.3; -y: 2.0 - 0; +x: 6 - 4.5; -x: 1.0 - 0.
-    assert np.array_equal(walled.frame.e1, [1.0, 0.0])
-    assert np.array_equal(walled.frame.e2, [0.0, -1.0])
+    # Room along e2 = +y: 6 - 5.3; -y: 2.0 - 0; +x: 6 - 4.5; -x: 1.0 - 0; the most area
+    # beyond the farthest pillar lies towards the corner (0, 0).
+    assert walled.frame.e2[1] < 0 and walled.frame.e2[0] < 0, walled.frame.e2
     assert np.array_equal(Workspace(pillars, **bodies).frame.e2, [0.0, 1.0])
     result = plan(walled, configurations)
     assert (result.positions - 0.2 >= hall[:, 0]).all()

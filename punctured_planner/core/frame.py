@@ -12,10 +12,14 @@ from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
+from scipy.spatial import ConvexHull, QhullError
 
 from .errors import ErrorCode, PlanningError
 
 _ORTHONORMAL_TOLERANCE = 1e-9
+# With walls in the plane, the directions e2 may take: this many evenly spaced angles, the
+# four axis directions among them (doc/design.md section 4).
+_WALL_DIRECTIONS = 32
 
 
 @dataclass(frozen=True, eq=False)
@@ -78,10 +82,54 @@ def _axis_frames(d):
                 yield a, (a + step) % d, sign
 
 
-def _room(obstacles, bounds, b, sign):
-    """Return how far the wall that e2 = sign x axis b points to lies beyond every obstacle."""
-    wall = bounds[b, 1] if sign > 0 else -bounds[b, 0]
-    return float(wall - (sign * obstacles[:, b]).max())
+def _frame_directions(d, oblique):
+    """
+    Yield the directions (e1, e2) a frame may take: the axis frames, then with oblique more.
+
+    oblique (walls, in the plane): e2 also takes the other _WALL_DIRECTIONS evenly
+    spaced angles, e1 being e2 turned a quarter, towards the positive side of its
+    larger coordinate.
+    """
+    for a, b, sign in _axis_frames(d):
+        e1, e2 = np.zeros(d), np.zeros(d)
+        e1[a], e2[b] = 1.0, sign
+        yield e1, e2
+    if not oblique or d != 2:
+        return
+    for angle in 2.0 * np.pi * np.arange(_WALL_DIRECTIONS) / _WALL_DIRECTIONS:
+        e2 = np.array([np.cos(angle), np.sin(angle)])
+        if np.all(np.abs(e2) > 1e-12):  # the axis directions came first
+            e1 = np.array([e2[1], -e2[0]])
+            yield e1 * np.sign(e1[int(np.argmax(np.abs(e1)))]), e2
+
+
+def _room(obstacles, bounds, e2):
+    """
+    Return the measure (area, volume) of the walls' box beyond every obstacle along e2.
+
+    The box cut by the plane through the farthest obstacle along e2 is convex: its
+    vertices are the corners beyond the plane and the points where the box's edges
+    cross it, and their convex hull (qhull) is where every construction stages and
+    runs its lanes.
+    """
+    d = bounds.shape[0]
+    corners = np.stack(np.meshgrid(*bounds, indexing='ij'), axis=-1).reshape(-1, d)
+    height = corners @ e2 - float((obstacles @ e2).max())
+    if height.max() <= 0.0:
+        return 0.0
+    # The box's edges: corners whose indices differ in one bit, that is along one axis.
+    low = [(i, i | 1 << bit) for i in range(corners.shape[0]) for bit in range(d)
+           if not i >> bit & 1]
+    first, second = (np.array(ends) for ends in zip(*low))
+    crossing = height[first] * height[second] < 0.0
+    first, second = first[crossing], second[crossing]
+    share = (height[first] / (height[first] - height[second]))[:, None]
+    points = np.concatenate([corners[height >= 0.0],
+                             corners[first] + share * (corners[second] - corners[first])])
+    try:
+        return float(ConvexHull(points).volume)
+    except QhullError:  # a sliver too thin for qhull: no room worth the name
+        return 0.0
 
 
 def _origin(obstacles, bounds, e1):
@@ -103,7 +151,8 @@ def _origin(obstacles, bounds, e1):
     return centre - (centre @ e1) * e1
 
 
-def choose_frame(obstacles: np.ndarray, bounds: np.ndarray | None = None) -> Frame:
+def choose_frame(obstacles: np.ndarray, bounds: np.ndarray | None = None,
+                 oblique: bool = False) -> Frame:
     """
     Return the default frame for obstacles (r, d): deterministic, fixed per workspace.
 
@@ -111,25 +160,25 @@ def choose_frame(obstacles: np.ndarray, bounds: np.ndarray | None = None) -> Fra
     part (_origin). The directions are the coordinate axes (e1 = x, e2 = y) whenever the
     obstacles' x coordinates are distinct; otherwise the next coordinate axis that
     works; otherwise the moment-curve direction that maximises the smallest gap between
-    obstacle projections. With walls (bounds (d, 2)) and obstacles, the axis frame (e1 a
-    coordinate axis that separates them, e2 another one either way) with the most room
-    between the wall e2 points to and the farthest obstacle along e2, where the
-    construction stages and runs its lanes (the first of _axis_frames on a tie;
-    doc/design.md section 17).
+    obstacle projections. With walls (bounds (d, 2)) and obstacles, of the frames that
+    separate them (the axis frames, and with oblique in the plane e2 at _WALL_DIRECTIONS
+    angles: for bodies whose margins are far above the rounding an oblique frame brings
+    into every projection, not for point robots) the one with the most room (_room: the
+    area, or volume, of the walls' box beyond the farthest obstacle along e2), where every
+    construction stages and runs its lanes (the first on a tie, the axis frames first;
+    doc/design.md sections 4 and 17).
     """
     r, d = obstacles.shape
-    separating = [a for a in range(d)
-                  if r < 2 or np.all(np.diff(np.sort(obstacles[:, a])) > 0)]
-    frames = [(a, b, sign) for a, b, sign in _axis_frames(d) if a in separating]
+    walls = bounds is not None and r > 0
+    frames = [Frame(_origin(obstacles, bounds, e1), e1, e2)
+              for e1, e2 in _frame_directions(d, oblique=walls and oblique)]
+    # Distinct projections, taken as the workspace takes them (Frame.project).
+    frames = [frame for frame in frames
+              if r < 2 or np.all(np.diff(np.sort(frame.project(obstacles))) > 0)]
     if frames:
-        if bounds is not None and r:
-            rooms = [_room(obstacles, bounds, b, sign) for _, b, sign in frames]
-            a, b, sign = frames[int(np.argmax(rooms))]
-        else:
-            a, b, sign = frames[0]
-        e1, e2 = np.zeros(d), np.zeros(d)
-        e1[a], e2[b] = 1.0, sign
-        return Frame(_origin(obstacles, bounds, e1), e1, e2)
+        if not walls:
+            return frames[0]
+        return frames[int(np.argmax([_room(obstacles, bounds, frame.e2) for frame in frames]))]
     count = max(16, (r * (r - 1) // 2) * (d - 1) + 1)
     directions = _moment_curve_directions(d, count)
     gaps = np.diff(np.sort(obstacles @ directions.T, axis=0), axis=0).min(axis=0)

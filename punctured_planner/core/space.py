@@ -90,7 +90,9 @@ class Workspace:
         self.robot_radius, self.obstacle_radii = _checked_radii(robot_radius, obstacle_radius,
                                                                 len(obstacles))
         self._reject_coincident_obstacles()
-        self.frame = (choose_frame(obstacles, self.bounds) if frame is None
+        # Oblique frames round every projection: only the discs' margins are far above that.
+        self.frame = (choose_frame(obstacles, self.bounds, oblique=variant == 'discs')
+                      if frame is None
                       else checked_frame(frame, self.dimension))
         self.obstacle_projections = self.frame.project(obstacles)
         same = _coincident_pair(self.obstacle_projections)
