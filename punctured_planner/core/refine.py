@@ -63,8 +63,10 @@ FULL_ROBOTS, MAX_ROBOTS = 64, 256
 # The longest move of a knot in one block, as a share of the fleet's scale.
 STEP = 0.2
 # Over-relaxation factor: about 2 / (1 + sin(pi / KNOTS)) is the classical optimum; less
-# is steadier under the caps.
-RELAXATION = 1.9
+# is steadier under the caps: with 1.9 a change of input grew about 3.5x a block from the
+# fourth on for a few point fleets (127x in all, doc/design.md section 14), with 1.7 the
+# same fleets 5x, and the realistic ones come out as long.
+RELAXATION = 1.7
 # Caps: a quarter of a robot pair's slack (each robot moves at most that, so the pair's
 # distance changes by at most half of it), half of a robot-pillar slack.
 PAIR_SHARE, PILLAR_SHARE = 0.25, 0.5
