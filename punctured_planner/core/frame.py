@@ -118,9 +118,9 @@ def _room(obstacles, bounds, e2):
     if height.max() <= 0.0:
         return 0.0
     # The box's edges: corners whose indices differ in one bit, that is along one axis.
-    low = [(i, i | 1 << bit) for i in range(corners.shape[0]) for bit in range(d)
-           if not i >> bit & 1]
-    first, second = (np.array(ends) for ends in zip(*low))
+    edges = [(i, i | 1 << bit) for i in range(corners.shape[0]) for bit in range(d)
+             if not i >> bit & 1]
+    first, second = (np.array(ends) for ends in zip(*edges))
     crossing = height[first] * height[second] < 0.0
     first, second = first[crossing], second[crossing]
     share = (height[first] / (height[first] - height[second]))[:, None]
