@@ -45,6 +45,25 @@ def requests(draw, max_robots=8, max_obstacles=5, max_configurations=5, modes=MO
             np.array(configurations, dtype=float), mode)
 
 
+def same_cells(workspace, first, second):
+    """
+    Return whether two requests (n, k, d) lie in the same cells of the strata.
+
+    Every configuration's order of all k + r projections onto e1, ties
+    included, must be the same: a stratum is a disjoint union of such cells, and
+    the motion is continuous on each (doc/design.md sections 6 and 7) but may
+    jump between two, as when a nudge takes a robot 1e-6 from another past it
+    (equal projection counts, robots in swapped slots).
+    """
+    def signs(configurations):
+        pillars = np.broadcast_to(workspace.obstacle_projections,
+                                  (len(configurations), len(workspace.obstacles)))
+        both = np.concatenate([workspace.frame.project(configurations), pillars], axis=1)
+        return np.sign(both[:, :, None] - both[:, None, :])
+
+    return np.array_equal(signs(first), signs(second))
+
+
 def separation(workspace):
     """Return S = max(4R, 2R + nu + max_j w_j), the theorem's robot spacing (design, 6)."""
     radius = workspace.robot_radius
