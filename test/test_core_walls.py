@@ -334,6 +334,10 @@ def test_the_walls_choose_an_oblique_frame_where_every_wall_has_a_pillar_by_it()
     result = plan(walled, configurations)
     assert (result.positions - 0.2 >= hall[:, 0]).all()
     assert (result.positions + 0.2 <= hall[:, 1]).all()
+    # The paper variant's domains in that frame: the discs keep them frame for frame.
+    paper = plan(Workspace(pillars, frame=walled.frame), configurations, certify=False)
+    assert (paper.domain, paper.domain_index) == (result.domain, result.domain_index)
+    assert np.array_equal(paper.projection_counts, result.projection_counts)
     for e1, e2 in (((1, 0), (0, 1)), ((1, 0), (0, -1)), ((0, 1), (1, 0)), ((0, 1), (-1, 0))):
         axes = Workspace(pillars, bounds=hall, frame=((3.0, 3.0), e1, e2), **bodies)
         with pytest.raises(PlanningError) as refused:
