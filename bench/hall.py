@@ -35,6 +35,7 @@ import numpy as np
 from peers import length_ratio
 from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
 from punctured_planner.core.discs import rise
+from punctured_planner.core.walls import box_corners
 from refinement import each_fleet, PILLAR, RADIUS
 
 MARGIN = 0.15
@@ -106,7 +107,7 @@ def _room(fleet, workspace, unwalled, side) -> Room:
     construction's.
     """
     frame, layout = workspace.frame, workspace.disc_layout
-    corners = np.stack(np.meshgrid(*workspace.bounds, indexing='ij'), axis=-1).reshape(-1, 2)
+    corners = box_corners(workspace.bounds)
     room = float(frame.offset(corners).max()) - RADIUS - layout.top
     width = float(np.ptp(frame.project(corners))) - 2 * RADIUS
     risen = max(float((h + rise(p, h, layout, layout.reaches(c)).lift[-1]).max())

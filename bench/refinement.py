@@ -295,12 +295,10 @@ def summary(results):
         f'{share(range(3, 41))}% (target <= 15%), k = 100 - 200 {share(large)}%.',
         f'- Refined plans with min_gap >= their margin: '
         f'{sum(r.gap >= r.margin for r in refined)} of {len(refined)} (target all).',
-        '- Bodies apart (min_gap >= 0), construction and refined: discs (d = 2) '
-        + ' and '.join(_apart([r for r in results if r.planner == planner and r.fleet.d == 2])
-                       for planner in (RAW, REFINED))
-        + ', balls (d = 3) '
-        + ' and '.join(_apart([r for r in results if r.planner == planner and r.fleet.d == 3])
-                       for planner in (RAW, REFINED))
+        '- Bodies apart (min_gap >= 0), construction and refined: '
+        + ', '.join(f'{bodies} (d = {d}) ' + ' and '.join(
+            _apart([r for r in results if r.planner == planner and r.fleet.d == d])
+            for planner in (RAW, REFINED)) for d, bodies in ((2, 'discs'), (3, 'balls')))
         + ' (doc/design.md section 6: each ball meets a pillar with its own reach).',
         f'- Planning time with the certificate, k = 40 n = 3: refined '
         f'{milliseconds(REFINED, 40)} ms (target < 50 ms), construction '

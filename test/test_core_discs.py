@@ -48,6 +48,24 @@ def test_bodies_keep_the_margin_when_the_condition_holds(case):
         assert keeps_margin(p), (refine, p.min_gap, p.gap, p.leg_names[p.gap.leg])
 
 
+def _balls_among_balls(rng, count, pillars, apart, clear, tries):
+    """
+    Return up to count ball centres in the 4 m cube: apart from each other, clear of pillars.
+
+    Each of tries uniform draws is kept if it keeps those distances; fewer than
+    count come back when the draws run out.
+    """
+    points = np.zeros((0, 3))
+    for _ in range(tries):
+        point = rng.uniform(0.0, 4.0, 3)
+        if (np.all(np.linalg.norm(points - point, axis=1) >= apart)
+                and np.all(np.linalg.norm(pillars - point, axis=1) >= clear)):
+            points = np.vstack([points, point])
+            if len(points) == count:
+                break
+    return points
+
+
 @PROPERTY
 @given(st.integers(2, 14), st.integers(1, 3), st.sampled_from([0.5, 1.0, 1.5]),
        st.integers(0, 2 ** 16))
@@ -64,30 +82,12 @@ def test_balls_keep_the_margin_when_the_condition_holds(count, pillar_count, rho
     clear = radius + rho_over_radius * radius
     configurations = []
     for _ in range(3):
-        points = np.zeros((0, 3))
-        for _ in range(2000):
-            point = rng.uniform(0.0, 4.0, 3)
-            if (np.all(np.linalg.norm(points - point, axis=1) >= apart)
-                    and np.all(np.linalg.norm(pillars - point, axis=1) >= clear)):
-                points = np.vstack([points, point])
-                if len(points) == count:
-                    break
+        points = _balls_among_balls(rng, count, pillars, apart, clear, tries=2000)
         assume(len(points) == count)
         configurations.append(points)
     for refine in (False, True):
         p = plan(workspace, configurations, certify=False, refine=refine)
         assert keeps_margin(p), (refine, p.min_gap, p.gap, p.leg_names[p.gap.leg])
-
-
-def _balls_among_balls(rng, count, pillars, apart, clear):
-    """Return count ball centres in the 4 m cube, apart from each other, clear of pillars."""
-    points = np.zeros((0, 3))
-    while len(points) < count:
-        point = rng.uniform(0.0, 4.0, 3)
-        if (np.all(np.linalg.norm(points - point, axis=1) >= apart)
-                and np.all(np.linalg.norm(pillars - point, axis=1) >= clear)):
-            points = np.vstack([points, point])
-    return points
 
 
 @pytest.mark.parametrize('seed', range(8))
@@ -109,8 +109,8 @@ def test_balls_pass_pillars_whose_shadows_meet_only_in_the_frames_plane(seed):
     assert abs(p[0] - p[1]) < layout.reach[0] + layout.reach[1] + layout.apart
     assert abs(h[0] - h[1]) < layout.zone[0] + layout.zone[1] + layout.apart
     assert len(layout.conflicting_pillars()) == 0
-    configurations = [_balls_among_balls(rng, 40, pillars, separation(workspace), 0.55)
-                      for _ in range(3)]
+    configurations = [_balls_among_balls(rng, 40, pillars, separation(workspace), 0.55,
+                                         tries=100_000) for _ in range(3)]
     for refine in (False, True):
         result = plan(workspace, configurations, refine=refine)
         assert keeps_margin(result), (refine, result.min_gap, result.leg_names[result.gap.leg])

@@ -15,6 +15,7 @@ import numpy.typing as npt
 from scipy.spatial import ConvexHull, QhullError
 
 from .errors import ErrorCode, PlanningError
+from .walls import box_corners
 
 _ORTHONORMAL_TOLERANCE = 1e-9
 # With walls in the plane, the directions e2 may take: this many evenly spaced angles, the
@@ -112,14 +113,13 @@ def _room(obstacles, bounds, e2):
     cross it, and their convex hull (qhull) is where every construction stages and
     runs its lanes.
     """
-    d = bounds.shape[0]
-    corners = np.stack(np.meshgrid(*bounds, indexing='ij'), axis=-1).reshape(-1, d)
+    corners = box_corners(bounds)
     height = corners @ e2 - float((obstacles @ e2).max())
     if height.max() <= 0.0:
         return 0.0
-    # The box's edges: corners whose indices differ in one bit, that is along one axis.
-    edges = [(i, i | 1 << bit) for i in range(corners.shape[0]) for bit in range(d)
-             if not i >> bit & 1]
+    # The box's edges: corners whose indices differ in one bit (box_corners).
+    edges = [(i, i | 1 << bit) for i in range(corners.shape[0])
+             for bit in range(bounds.shape[0]) if not i >> bit & 1]
     first, second = (np.array(ends) for ends in zip(*edges))
     crossing = height[first] * height[second] < 0.0
     first, second = first[crossing], second[crossing]

@@ -89,6 +89,16 @@ def checked_bounds(bounds: npt.ArrayLike | None, dimension: int) -> np.ndarray |
     return array
 
 
+def box_corners(bounds: np.ndarray) -> np.ndarray:
+    """
+    Return the (2^d, d) corners of the box bounds (d, 2).
+
+    Corner i takes axis a's high wall where bit d - 1 - a of i is set, so two
+    corners whose indices differ in one bit are the ends of one of the box's edges.
+    """
+    return np.stack(np.meshgrid(*bounds, indexing='ij'), axis=-1).reshape(-1, bounds.shape[0])
+
+
 def _two_sum(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Return (s, e): s = fl(a + b) and its rounding error, a + b = s + e exactly (Knuth)."""
     total = a + b
