@@ -134,8 +134,12 @@ def run_ours(fleet, variant, repeats=3):
     seconds is the best of repeats with the exact gap certificate, build_seconds
     without it (the plan's breakpoints only).
     """
-    workspace = Workspace(fleet.pillars, variant=variant, robot_radius=RADIUS,
-                          obstacle_radius=fleet.radii)
+    bodies = {'robot_radius': RADIUS, 'obstacle_radius': fleet.radii}
+    discs = Workspace(fleet.pillars, variant='discs', **bodies)
+    # The paper variant in the discs' frame, which may be oblique (design section 4).
+    workspace = discs if variant == 'discs' else Workspace(
+        fleet.pillars, variant=variant, frame=discs.frame if variant == 'paper' else None,
+        **bodies)
     best = build = np.inf
     for _ in range(repeats):
         begin = time.perf_counter()

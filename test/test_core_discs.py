@@ -173,12 +173,18 @@ def test_realistic_requests_are_not_refused_for_a_rounding_error(radius, rho):
 @PROPERTY
 @given(requests(max_robots=6, max_obstacles=4, max_configurations=4))
 def test_domains_equal_the_paper_variant_and_waypoints_are_exact(request):
-    """Same projection counts, domain, index, count and TC_n; C_m is a breakpoint exactly."""
+    """
+    Same projection counts, domain, index, count and TC_n; C_m is a breakpoint exactly.
+
+    The paper variant is given the discs' frame (doc/design.md section 4: the bodies'
+    frame may be oblique, the point variants' is an axis frame).
+    """
     obstacles, configurations, _ = request
     d = obstacles.shape[1]
-    paper = plan(Workspace(obstacles, dimension=d), configurations, certify=False)
-    discs = plan(Workspace(obstacles, dimension=d, variant='discs'), configurations,
+    workspace = Workspace(obstacles, dimension=d, variant='discs')
+    paper = plan(Workspace(obstacles, dimension=d, frame=workspace.frame), configurations,
                  certify=False)
+    discs = plan(workspace, configurations, certify=False)
     assert np.array_equal(discs.projection_counts, paper.projection_counts)
     assert (discs.domain, discs.domain_index, discs.domain_count) == (
         paper.domain, paper.domain_index, paper.domain_count)
@@ -380,3 +386,27 @@ def test_without_pillars_the_motion_stays_by_the_fleet_wherever_the_origin_is(
     assert result.positions[..., 1].min() >= heights.min() - count * pitch
     assert result.positions[..., 1].max() <= heights.max() + count * pitch
     assert result.min_gap >= result.margin > 0
+
+
+def test_without_walls_the_frame_stages_beside_a_line_of_pillars():
+    """
+    Pillars on a diagonal: e2 is across it, and the plan is shorter than the axis frame's.
+
+    Every construction takes the robots beyond the farthest pillar along e2 and back;
+    across the line that is the line itself (core.frame.choose_frame: the farthest
+    pillar nearest the pillars' middle, doc/design.md section 4), along y it is the
+    pillar at the top corner, which every robot below it climbs to.
+    """
+    pillars = np.array([[0.0, 0.0], [1.5, 1.5], [3.0, 3.0], [4.5, 4.5]])
+    configurations = np.array([[[0.5, 2.5], [2.0, 4.0], [3.0, 0.8], [4.5, 2.5]],
+                               [[2.5, 4.2], [0.3, 1.8], [4.6, 2.9], [2.0, 0.2]]])
+    bodies = {'variant': 'discs', 'robot_radius': 0.2, 'obstacle_radius': 0.15}
+    workspace = Workspace(pillars, **bodies)
+    assert abs(workspace.frame.e2 @ [1.0, 1.0]) < 1e-12, workspace.frame.e2
+    axes = Workspace(pillars, frame=((0.0, 0.0), (1.0, 0.0), (0.0, 1.0)), **bodies)
+    for refine in (False, True):
+        ours, upright = (plan(w, configurations, refine=refine) for w in (workspace, axes))
+        lengths = [np.linalg.norm(np.diff(p.positions, axis=0), axis=-1).sum()
+                   for p in (ours, upright)]
+        assert lengths[0] < 0.8 * lengths[1], (refine, lengths)
+        assert ours.min_gap > 0

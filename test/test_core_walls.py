@@ -356,7 +356,8 @@ def test_the_walls_choose_the_frame_with_the_most_room_beyond_the_obstacles():
     # Room along e2 = +y: 6 - 5.3; -y: 2.0 - 0; +x: 6 - 4.5; -x: 1.0 - 0; the most area
     # beyond the farthest pillar lies towards the corner (0, 0).
     assert walled.frame.e2[1] < 0 and walled.frame.e2[0] < 0, walled.frame.e2
-    assert np.array_equal(Workspace(pillars, **bodies).frame.e2, [0.0, 1.0])
+    # Without walls the farthest pillar nearest the pillars' middle sets it (upwards).
+    assert Workspace(pillars, **bodies).frame.e2[1] > 0
     result = plan(walled, configurations)
     assert (result.positions - 0.2 >= hall[:, 0]).all()
     assert (result.positions + 0.2 <= hall[:, 1]).all()

@@ -18,9 +18,9 @@ from .errors import ErrorCode, PlanningError
 from .walls import box_corners
 
 _ORTHONORMAL_TOLERANCE = 1e-9
-# With walls in the plane, the directions e2 may take: this many evenly spaced angles, the
+# For bodies in the plane, the directions e2 may take: this many evenly spaced angles, the
 # four axis directions among them (doc/design.md section 4).
-_WALL_DIRECTIONS = 32
+_OBLIQUE_DIRECTIONS = 32
 
 
 @dataclass(frozen=True, eq=False)
@@ -87,7 +87,7 @@ def _frame_directions(d, oblique):
     """
     Yield the directions (e1, e2) a frame may take: the axis frames, then with oblique more.
 
-    oblique (walls, in the plane): e2 also takes the other _WALL_DIRECTIONS evenly
+    oblique (bodies, in the plane): e2 also takes the other _OBLIQUE_DIRECTIONS evenly
     spaced angles, e1 being e2 turned a quarter, towards the positive side of its
     larger coordinate.
     """
@@ -97,7 +97,7 @@ def _frame_directions(d, oblique):
         yield e1, e2
     if not oblique or d != 2:
         return
-    for angle in 2.0 * np.pi * np.arange(_WALL_DIRECTIONS) / _WALL_DIRECTIONS:
+    for angle in 2.0 * np.pi * np.arange(_OBLIQUE_DIRECTIONS) / _OBLIQUE_DIRECTIONS:
         e2 = np.array([np.cos(angle), np.sin(angle)])
         if np.all(np.abs(e2) > 1e-12):  # the axis directions came first
             e1 = np.array([e2[1], -e2[0]])
@@ -132,6 +132,19 @@ def _room(obstacles, bounds, e2):
         return 0.0
 
 
+def _reach(obstacles, e2):
+    """
+    Return how far the farthest obstacle lies along e2 from the middle of the obstacles.
+
+    The middle is the centre of their bounding box, which stands for the middle of the
+    floor the robots share with them. Every construction takes the robots beyond the
+    farthest obstacle along e2 and back, so a robot about the middle climbs about this
+    far, twice a segment: without walls the bodies' frame makes it least.
+    """
+    middle = 0.5 * (obstacles.min(axis=0) + obstacles.max(axis=0))
+    return float(((obstacles - middle) @ e2).max())
+
+
 def _origin(obstacles, bounds, e1):
     """
     Return o: the obstacles' centroid (else the walls' centre, else 0) less its e1 part.
@@ -157,28 +170,32 @@ def choose_frame(obstacles: np.ndarray, bounds: np.ndarray | None = None,
     Return the default frame for obstacles (r, d): deterministic, fixed per workspace.
 
     The origin o is the obstacles' centroid (else the walls' centre, else 0) less its e1
-    part (_origin). The directions are the coordinate axes (e1 = x, e2 = y) whenever the
-    obstacles' x coordinates are distinct; otherwise the next coordinate axis that
-    works; otherwise the moment-curve direction that maximises the smallest gap between
-    obstacle projections. With walls (bounds (d, 2)) and obstacles, of the frames that
-    separate them (the axis frames, and with oblique in the plane e2 at _WALL_DIRECTIONS
-    angles: for bodies whose margins are far above the rounding an oblique frame brings
-    into every projection, not for point robots) the one with the most room (_room: the
-    area, or volume, of the walls' box beyond the farthest obstacle along e2), where every
-    construction stages and runs its lanes (the first on a tie, the axis frames first;
-    doc/design.md sections 4 and 17).
+    part (_origin). The candidates are the frames that separate the obstacles: the axis
+    frames, and with oblique (bodies, whose margins are far above the rounding an
+    oblique frame brings into every projection; not point robots) in the plane e2 at
+    _OBLIQUE_DIRECTIONS angles. Every construction stages and runs its lanes beyond the
+    farthest obstacle along e2, so with walls (bounds (d, 2)) the frame is the one with
+    the most room there (_room: the area, or volume, of the walls' box beyond that
+    obstacle); without walls, for bodies, the one whose farthest obstacle is nearest the
+    middle of the obstacles (_reach); otherwise the first, the coordinate axes when they
+    separate the obstacles (e1 = x, e2 = y). Ties go to the first, the axis frames
+    first. With no axis frame separating the obstacles, the moment-curve direction that
+    maximises the smallest gap between their projections (doc/design.md sections 4
+    and 17).
     """
     r, d = obstacles.shape
-    walls = bounds is not None and r > 0
     frames = [Frame(_origin(obstacles, bounds, e1), e1, e2)
-              for e1, e2 in _frame_directions(d, oblique=walls and oblique)]
+              for e1, e2 in _frame_directions(d, oblique=oblique and r > 0)]
     # Distinct projections, taken as the workspace takes them (Frame.project).
     frames = [frame for frame in frames
               if r < 2 or np.all(np.diff(np.sort(frame.project(obstacles))) > 0)]
     if frames:
-        if not walls:
-            return frames[0]
-        return frames[int(np.argmax([_room(obstacles, bounds, frame.e2) for frame in frames]))]
+        if r > 0 and bounds is not None:
+            return frames[int(np.argmax([_room(obstacles, bounds, frame.e2)
+                                         for frame in frames]))]
+        if r > 0 and oblique:
+            return frames[int(np.argmin([_reach(obstacles, frame.e2) for frame in frames]))]
+        return frames[0]
     count = max(16, (r * (r - 1) // 2) * (d - 1) + 1)
     directions = _moment_curve_directions(d, count)
     gaps = np.diff(np.sort(obstacles @ directions.T, axis=0), axis=0).min(axis=0)
