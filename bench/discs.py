@@ -135,11 +135,10 @@ def run_ours(fleet, variant, repeats=3):
     without it (the plan's breakpoints only).
     """
     bodies = {'robot_radius': RADIUS, 'obstacle_radius': fleet.radii}
-    discs = Workspace(fleet.pillars, variant='discs', **bodies)
-    # The paper variant in the discs' frame, which may be oblique (design section 4).
-    workspace = discs if variant == 'discs' else Workspace(
-        fleet.pillars, variant=variant, frame=discs.frame if variant == 'paper' else None,
-        **bodies)
+    frame = None
+    if variant == 'paper':  # in the discs' frame, which may be oblique (design section 4)
+        frame = Workspace(fleet.pillars, variant='discs', **bodies).frame
+    workspace = Workspace(fleet.pillars, variant=variant, frame=frame, **bodies)
     best = build = np.inf
     for _ in range(repeats):
         begin = time.perf_counter()

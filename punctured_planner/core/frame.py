@@ -189,12 +189,11 @@ def choose_frame(obstacles: np.ndarray, bounds: np.ndarray | None = None,
     # Distinct projections, taken as the workspace takes them (Frame.project).
     frames = [frame for frame in frames
               if r < 2 or np.all(np.diff(np.sort(frame.project(obstacles))) > 0)]
+    if frames and r > 0 and bounds is not None:
+        return frames[int(np.argmax([_room(obstacles, bounds, frame.e2) for frame in frames]))]
+    if frames and r > 0 and oblique:
+        return frames[int(np.argmin([_reach(obstacles, frame.e2) for frame in frames]))]
     if frames:
-        if r > 0 and bounds is not None:
-            return frames[int(np.argmax([_room(obstacles, bounds, frame.e2)
-                                         for frame in frames]))]
-        if r > 0 and oblique:
-            return frames[int(np.argmin([_reach(obstacles, frame.e2) for frame in frames]))]
         return frames[0]
     count = max(16, (r * (r - 1) // 2) * (d - 1) + 1)
     directions = _moment_curve_directions(d, count)
