@@ -410,3 +410,19 @@ def test_without_walls_the_frame_stages_beside_a_line_of_pillars():
                    for p in (ours, upright)]
         assert lengths[0] < 0.8 * lengths[1], (refine, lengths)
         assert ours.min_gap > 0
+
+
+def test_an_oblique_frame_must_save_more_than_a_robot_radius_of_climb():
+    """
+    Pillars almost on a line along x keep the axis frame unless the robots are small.
+
+    Turning e2 by 11 degrees brings the farthest of these pillars 0.06 m nearer their
+    middle (core.frame._reach); the axis frames keep the request's own coordinates, so an
+    oblique frame is taken only where it saves more than a robot radius (doc/design.md
+    section 4).
+    """
+    pillars = np.array([[-2.0, 0.5], [0.0, -0.5], [2.5, 0.0]])
+    frames = {radius: Workspace(pillars, variant='discs', robot_radius=radius,
+                                obstacle_radius=0.15).frame for radius in (0.05, 0.1)}
+    assert np.count_nonzero(frames[0.05].e2) == 2, frames[0.05].e2
+    np.testing.assert_array_equal(frames[0.1].e2, [0.0, 1.0])

@@ -164,8 +164,13 @@ def _origin(obstacles, bounds, e1):
     return centre - (centre @ e1) * e1
 
 
+def _is_axis(frame):
+    """Return whether e2 is a coordinate axis (either way): an axis frame (_axis_frames)."""
+    return int(np.count_nonzero(frame.e2)) == 1
+
+
 def choose_frame(obstacles: np.ndarray, bounds: np.ndarray | None = None,
-                 oblique: bool = False) -> Frame:
+                 oblique: bool = False, robot_radius: float = 0.0) -> Frame:
     """
     Return the default frame for obstacles (r, d): deterministic, fixed per workspace.
 
@@ -177,9 +182,10 @@ def choose_frame(obstacles: np.ndarray, bounds: np.ndarray | None = None,
     farthest obstacle along e2, so with walls (bounds (d, 2)) the frame is the one with
     the most room there (_room: the area, or volume, of the walls' box beyond that
     obstacle); without walls, for bodies, the one whose farthest obstacle is nearest the
-    middle of the obstacles (_reach); otherwise the first, the coordinate axes when they
-    separate the obstacles (e1 = x, e2 = y). Ties go to the first, the axis frames
-    first. With no axis frame separating the obstacles, the moment-curve direction that
+    middle of the obstacles (_reach), an oblique frame only where it saves more than
+    robot_radius of that climb over every axis frame; otherwise the first, the coordinate
+    axes when they separate the obstacles (e1 = x, e2 = y). Ties go to the first, the
+    axis frames first. With no axis frame separating the obstacles, the moment-curve direction that
     maximises the smallest gap between their projections (doc/design.md sections 4
     and 17).
     """
@@ -192,7 +198,11 @@ def choose_frame(obstacles: np.ndarray, bounds: np.ndarray | None = None,
     if frames and r > 0 and bounds is not None:
         return frames[int(np.argmax([_room(obstacles, bounds, frame.e2) for frame in frames]))]
     if frames and r > 0 and oblique:
-        return frames[int(np.argmin([_reach(obstacles, frame.e2) for frame in frames]))]
+        # The axis frames keep the request's own coordinates (lanes along the building's
+        # walls, exact projections): an oblique one must pay for itself (design section 4).
+        return frames[int(np.argmin([_reach(obstacles, frame.e2)
+                                     - (robot_radius if _is_axis(frame) else 0.0)
+                                     for frame in frames]))]
     if frames:
         return frames[0]
     count = max(16, (r * (r - 1) // 2) * (d - 1) + 1)

@@ -91,7 +91,8 @@ class Workspace:
                                                                 len(obstacles))
         self._reject_coincident_obstacles()
         # Oblique frames round every projection: only the discs' margins are far above that.
-        self.frame = (choose_frame(obstacles, self.bounds, oblique=variant == 'discs')
+        self.frame = (choose_frame(obstacles, self.bounds, oblique=variant == 'discs',
+                                   robot_radius=self.robot_radius)
                       if frame is None
                       else checked_frame(frame, self.dimension))
         self.obstacle_projections = self.frame.project(obstacles)
