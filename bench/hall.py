@@ -34,7 +34,7 @@ from core_speed import grid_main, grid_report
 import numpy as np
 from peers import length_ratio
 from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
-from punctured_planner.core.discs import rise
+from punctured_planner.core.discs import rise, section
 from punctured_planner.core.walls import box_corners
 from refinement import each_fleet, PILLAR, RADIUS
 
@@ -99,13 +99,8 @@ def _unwalled(fleet, frame=None):
     return plan(workspace, fleet.configurations, certify=False)
 
 
-def _room(fleet, workspace, unwalled, side) -> Room:
-    """
-    Return the room above the staging height and along e1, and what the plan takes of it.
-
-    unwalled is the fleet's plan in the walls' frame without them: its lanes are the
-    construction's.
-    """
+def _room(fleet, workspace, side) -> Room:
+    """Return the room above the staging height and along e1, and what the plan takes of it."""
     frame, layout = workspace.frame, workspace.disc_layout
     corners = box_corners(workspace.bounds)
     room = float(frame.offset(corners).max()) - RADIUS - layout.top
@@ -113,7 +108,7 @@ def _room(fleet, workspace, unwalled, side) -> Room:
     risen = max(float((h + rise(p, h, layout, layout.reaches(c)).lift[-1]).max())
                 for c, p, h in zip(fleet.configurations, frame.project(fleet.configurations),
                                    frame.offset(fleet.configurations)))
-    lanes = float(unwalled.lanes.max())
+    lanes = float(section(fleet.configurations, layout).lane_heights.max())
     return Room(room / side, (risen - layout.top) / side, (lanes - layout.top) / side,
                 width / side, (fleet.k - 1) * layout.pitch / side)
 
@@ -128,7 +123,7 @@ def run_one(fleet) -> Outcome:
     framed = _unwalled(fleet, workspace.frame)
     lengths = (length_ratio(framed.positions, fleet.configurations),
                length_ratio(_unwalled(fleet).positions, fleet.configurations))
-    room = _room(fleet, workspace, framed, side)
+    room = _room(fleet, workspace, side)
     begin = time.perf_counter()
     try:
         result = plan(workspace, fleet.configurations)

@@ -11,10 +11,11 @@ lattice cells, columns of robots between pillars, mirror-image goals.
 """
 
 from core_strategies import lattice_requests, requests, same_cells, separation
-from hypothesis import assume, given, HealthCheck, settings, strategies as st
+from hypothesis import assume, example, given, HealthCheck, settings, strategies as st
 import numpy as np
 from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
-from punctured_planner.core.discs import MARGIN, rise, stacked_heights, STACKED_ROBOTS
+from punctured_planner.core.discs import (MARGIN, passing_orders, rise, shared_lanes,
+                                          stacked_heights, STACKED_ROBOTS)
 import pytest
 
 PROPERTY = settings(max_examples=120, deadline=None,
@@ -426,3 +427,28 @@ def test_an_oblique_frame_must_save_more_than_a_robot_radius_of_climb():
                                 obstacle_radius=0.15).frame for radius in (0.05, 0.1)}
     assert np.count_nonzero(frames[0.05].e2) == 2, frames[0.05].e2
     np.testing.assert_array_equal(frames[0.1].e2, [0.0, 1.0])
+
+
+@PROPERTY
+@given(st.integers(1, 30).flatmap(lambda k: st.tuples(st.permutations(range(k)),
+                                                      st.permutations(range(k)))),
+       st.integers(2, 8))
+@example(orders=(list(range(12)), list(range(11, -1, -1))), limit=2)
+@example(orders=(list(range(12)), list(range(12))), limit=2)
+@example(orders=([0], [0]), limit=2)
+def test_passing_orders_end_in_the_next_order_each_slide_within_the_lane_limit(orders, limit):
+    """
+    Any two slot orders, the identity and the reversal among them: the walls' slides.
+
+    Each order is a permutation of the slots, the last is the next order, and each
+    slide from the order before needs at most `limit` lanes (shared_lanes); the slides
+    are one exactly when one fits, as without walls (limit None).
+    """
+    first, second = (np.array(order) for order in orders)
+    steps = passing_orders(first, second, limit)
+    np.testing.assert_array_equal(steps[-1], second)
+    for before, after in zip([first, *steps[:-1]], steps):
+        np.testing.assert_array_equal(np.sort(after), np.arange(len(first)))
+        assert shared_lanes(before, after).max() < limit
+    assert (len(steps) == 1) == (shared_lanes(first, second).max() < limit)
+    assert len(passing_orders(first, second, None)) == 1

@@ -252,8 +252,10 @@ def test_a_plan_inside_its_walls_is_returned_and_one_outside_refused():
     p = plan(Workspace(pillars, bounds=roomy, frame=raw.workspace.frame, **options),
              [starts, goals])
     assert smallest_leg_slack(p.positions, roomy, 0.2).slack >= 0
-    tight = np.array([[-0.3, 6.3], [-0.8, 3.8]])
+    # A pillar 0.8 m above the starts leaves one lane below it, and no frame has room.
+    low_pillar = pillars - [[0.0, 0.7], [0.0, 0.0], [0.0, 0.0]]
+    tight = np.array([[-0.05, 6.05], [-0.75, 3.45]])
     with pytest.raises(PlanningError) as caught:
-        plan(Workspace(pillars, bounds=tight, **options), [starts, goals - [0.0, 0.3]])
+        plan(Workspace(low_pillar, bounds=tight, **options), [starts, goals - [0.0, 0.3]])
     assert caught.value.code == ErrorCode.OUTSIDE_WORKSPACE
     assert 'on leg' in str(caught.value)  # refused after planning, not as input

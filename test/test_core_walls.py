@@ -13,7 +13,10 @@ from core_strategies import lattice_requests, requests
 from hypothesis import given, HealthCheck, settings, strategies as st
 import numpy as np
 from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
+from punctured_planner.core.discs import section
 from punctured_planner.core.errors import Wall
+from punctured_planner.core.plan import Plan
+from punctured_planner.core.strata import projection_count, projection_gaps
 from punctured_planner.core.validation import validate_configurations
 from punctured_planner.core.walls import (checked_bounds, first_outside, smallest_leg_slack,
                                           wall_slack)
@@ -202,6 +205,13 @@ def test_a_plan_is_inside_its_bounds_or_refused_naming_where_it_leaves(
     assert (result.positions >= bounds[:, 0]).all() and (result.positions <= bounds[:, 1]).all()
 
 
+def walled_construction(walled, configurations):
+    """Return the discs construction plan() refines and judges below walled's walls."""
+    gaps = projection_gaps(walled.frame.project(configurations), walled.obstacle_projections)
+    return Plan.discs(walled, configurations, section(configurations, walled.disc_layout),
+                      projection_count(gaps))
+
+
 @settings(max_examples=40, deadline=None,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
 @given(lattice_requests(), st.sampled_from([0.0, 0.1, 0.5, 2.0]), st.booleans())
@@ -222,10 +232,9 @@ def test_disc_plans_keep_their_radius_from_every_wall_or_are_refused(case, margi
         result = plan(walled, configurations, refine=refine)
     except PlanningError as error:
         assert error.code == ErrorCode.OUTSIDE_WORKSPACE, str(error)
-        # the motion the refusal judged: the construction's, refined against the walls
-        free = plan(Workspace(workspace.obstacles, variant='discs', robot_radius=radius,
-                              obstacle_radius=rho, frame=walled.frame),
-                    configurations, refine=False)
+        # the motion the refusal judged: the construction's (its lanes below the walls),
+        # refined against the walls
+        free = walled_construction(walled, configurations)
         free = (refined_with_walls(free, bounds) if refine else free).positions
         leg, robot, wall = error.leg, error.robots[0], error.wall
         ends = free[leg:leg + 2, robot, wall.axis]
@@ -367,3 +376,32 @@ def test_the_walls_choose_the_frame_with_the_most_room_beyond_the_obstacles():
         plan(axes, configurations)
     assert refused.value.code == ErrorCode.OUTSIDE_WORKSPACE
     assert refused.value.wall == Wall(1, True), str(refused.value)
+
+
+def test_below_low_walls_the_robots_pass_in_the_lanes_that_fit():
+    """
+    Six robots reverse their order below a wall: one slide needs six lanes, the hall has three.
+
+    The construction then passes them in several slides of at most lane_limit lanes
+    (core.discs.passing_orders, doc/design.md section 17): inside the walls, bodies
+    apart, waypoints exact, the same domain as without walls in the same frame.
+    """
+    pillars = np.array([[1.0, 1.0], [3.0, 2.5], [5.0, 1.2]])
+    starts = np.stack([np.linspace(0.2, 5.8, 6), np.full(6, -0.5)], axis=1)
+    configurations = np.stack([starts, starts[::-1] + [0.0, 3.7]])
+    options = {'variant': 'discs', 'robot_radius': 0.2, 'obstacle_radius': 0.15}
+    bounds = np.array([[-0.3, 6.3], [-0.8, 3.8]])
+    walled = Workspace(pillars, bounds=bounds, **options)
+    free = Workspace(pillars, frame=walled.frame, **options)
+    assert walled.disc_layout.lane_limit == 3 and free.disc_layout.lane_limit is None
+    one_slide = plan(free, configurations, refine=False)
+    assert len(one_slide.lanes) == 6
+    assert smallest_leg_slack(one_slide.positions, bounds, 0.2).slack < -1.0
+    for refine in (False, True):
+        result = plan(walled, configurations, refine=refine)
+        assert smallest_leg_slack(result.positions, bounds, 0.2).slack >= 0
+        assert len(result.lanes) == 3 and result.leg_names.count('slide') > 1
+        assert result.min_gap > 0
+        np.testing.assert_array_equal(result.positions[result.waypoint_indices],
+                                      configurations)
+        assert result.domain_index == one_slide.domain_index

@@ -59,7 +59,9 @@ The construction keeps the paper's skeleton, H(C_m), Gamma, H(C_{m+1})^-1
   its next slot's column (and its next coordinates across e1 and e2) and moves
   along e2 within that column to its next base position. Robots whose
   slots keep their order share a lane (shared_lanes), so a segment needs as
-  many lanes as its longest run of robots whose order reverses, not k.
+  many lanes as its longest run of robots whose order reverses, not k. Below
+  walls that leave room for fewer lanes (lane_limit) the robots pass in several
+  slides of at most that many lanes (passing_orders; doc/design.md section 17).
 
 Continuity and domains. On a stratum A_i the order of all k + r projections,
 ties included, is locally constant, so the side of every push and the ranks
@@ -138,7 +140,8 @@ in h >= top, where every robot is at least z_j >= w_j from every pillar.
 g >= 2R + nu from the next one) between heights >= top, then slides in lanes
 g apart in e2 at heights >= top; two robots in one lane keep their order, so
 their e1 difference moves linearly between multiples of g: they stay g apart
-whatever their other coordinates do. The inverse
+whatever their other coordinates do; below walls, slide after slide on the
+same columns, with lifts within the columns between them. The inverse
 legs are the same legs run backwards. Without pillars there is no rise and
 (3), (4) hold from C itself. QED.
 
@@ -152,6 +155,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .frame import Frame
+from .walls import box_corners
 
 # The push zone of pillar j in relative height u: full push for |u| <= FULL w_j,
 # none beyond ZONE w_j, linear between. The push to w_j lambda_j(u) then traces
@@ -171,6 +175,21 @@ SIDESTEP, RISE, GATHER = 'sidestep', 'rise', 'gather'
 LIFT, SLIDE, DROP = 'lift', 'slide', 'drop'
 
 
+def lane_limit(frame: Frame, bounds: np.ndarray | None, robot_radius: float, top: float,
+               pitch: float) -> int | None:
+    """
+    Return how many lanes top + l g fit below the walls' far side, at least 2; None without walls.
+
+    The far side is the second farthest corner of the walls' box along e2, less R: in an
+    axis frame the far wall, in an oblique one the height beyond which the box narrows to
+    its farthest corner. Two lanes are the fewest that pass robots (passing_orders).
+    """
+    if bounds is None:
+        return None
+    ceiling = float(np.sort(frame.offset(box_corners(bounds)))[-2]) - robot_radius
+    return max(2, int(np.floor((ceiling - top) / pitch)) + 1)
+
+
 @dataclass(frozen=True, eq=False)
 class DiscLayout:
     """
@@ -181,8 +200,9 @@ class DiscLayout:
     less, reaches), the staging
     height top (with pillars; without, each segment's staging_height), the least
     distance apart 2R + nu that every robot pair keeps, the pitch g of the slots
-    and the lanes, and the stack's reach D_p and fade (stacked_heights; module
-    docstring).
+    and the lanes, the stack's reach D_p and fade (stacked_heights; module
+    docstring), and with walls the most lanes they leave room for (lane_limit;
+    None without walls).
     """
 
     frame: Frame
@@ -196,11 +216,17 @@ class DiscLayout:
     pitch: float
     pile_reach: float
     pile_fade: float
+    lane_limit: int | None
 
     @classmethod
     def from_radii(cls, frame: Frame, obstacles: np.ndarray, robot_radius: float,
-                   obstacle_radius: np.ndarray, min_spacing: float) -> 'DiscLayout':
-        """Return the layout for pillars (r, d) of radii (r,) and robots of radius R."""
+                   obstacle_radius: np.ndarray, min_spacing: float,
+                   bounds: np.ndarray | None = None) -> 'DiscLayout':
+        """
+        Return the layout for pillars (r, d) of radii (r,), robots of radius R, walls bounds.
+
+        bounds (d, 2), or None for no walls, give lane_limit (lane_limit).
+        """
         # A passing margin for every pillar size: mu_j = 0 (rho_j >= R, before) let bodies
         # graze. S stays 4R while w_j <= 1.9R (rho_j <= 0.8R); wider margins make
         # neighbouring pillars' zones overlap more often (measured in bench/).
@@ -219,7 +245,8 @@ class DiscLayout:
         # allows for the least it must keep, sqrt 2 (2R + nu) (module docstring).
         fade = np.sqrt(max(separation ** 2 - 2.0 * apart ** 2, 0.0))
         return cls(frame, obstacles, frame.project(obstacles), offsets, reach, ZONE * reach,
-                   top, apart, pitch, np.sqrt(2.0) * pitch, float(fade))
+                   top, apart, pitch, np.sqrt(2.0) * pitch, float(fade),
+                   lane_limit(frame, bounds, robot_radius, top, pitch))
 
     def reaches(self, configuration: np.ndarray) -> np.ndarray:
         """
@@ -391,6 +418,53 @@ def shared_lanes(first: np.ndarray, second: np.ndarray) -> np.ndarray:
     return lanes
 
 
+def transposition_rounds(first: np.ndarray, second: np.ndarray) -> list[np.ndarray]:
+    """
+    Return the slot orders of odd-even transposition sort from slots first to second.
+
+    Round t swaps the robots of slots i, i + 1 (i = t mod 2, t + 2, ...) whose second
+    slots are the other way round; rounds without a swap are left out. The last order
+    is second, after at most k rounds; each round's swaps are disjoint and adjacent, so
+    two lanes pass them (shared_lanes).
+    """
+    order = np.argsort(first)  # order[s]: the robot in slot s
+    orders = []
+    for parity in range(len(first)):
+        left = order[parity % 2:-1:2]
+        right = order[parity % 2 + 1::2]
+        swap = second[left] > second[right]
+        if swap.any():
+            order = order.copy()
+            order[parity % 2:-1:2][swap], order[parity % 2 + 1::2][swap] = (right[swap],
+                                                                            left[swap])
+            slots = np.empty_like(first)
+            slots[order] = np.arange(len(first))
+            orders.append(slots)
+    return orders
+
+
+def passing_orders(first: np.ndarray, second: np.ndarray,
+                   lane_limit: int | None) -> list[np.ndarray]:
+    """
+    Return the slot orders Gamma slides through from slots first to second, second last.
+
+    One slide when its shared lanes are at most lane_limit (always without walls).
+    Otherwise the orders of transposition_rounds, as few of them as greedily fit: from
+    each order the farthest later one whose slide needs at most lane_limit lanes. Every
+    round fits in two, so this ends; it depends on the two rank orders only.
+    """
+    if lane_limit is None or shared_lanes(first, second).max() < lane_limit:
+        return [second]
+    rounds = transposition_rounds(first, second)
+    orders, current, start = [], first, 0
+    while start < len(rounds):
+        start = next(end for end in range(len(rounds), start, -1)
+                     if shared_lanes(current, rounds[end - 1]).max() < lane_limit)
+        current = rounds[start - 1]
+        orders.append(current)
+    return orders
+
+
 @dataclass(frozen=True)
 class DiscSection:
     """The breakpoints of the whole motion, leg names, waypoints' indices, lanes' e2 offsets."""
@@ -440,19 +514,31 @@ def section(configurations: np.ndarray, layout: DiscLayout) -> DiscSection:
     for m in range(n - 1):
         risen, rise_names, rank, columns = deformations[m]
         back, back_names, next_rank, next_columns = deformations[m + 1]
-        # Lane 0 is the staging height itself: its robots need no lift.
-        lanes = shared_lanes(rank, next_rank)
-        top = staging_height(layout, offsets[m:m + 2], int(lanes.max()))
-        lift = lanes * layout.pitch
-        heights.update((top + lift).tolist())
-        # A slot is its column at the staging height, other coordinates (d >= 3) kept.
+        # Lane 0 is the staging height itself: its robots need no lift. Below walls the
+        # robots may pass in several slides, each within the lanes the walls leave
+        # (passing_orders), a lift along each robot's column between two.
+        orders = passing_orders(rank, next_rank, layout.lane_limit)
+        lanes = [shared_lanes(before, after)
+                 for before, after in zip([rank, *orders[:-1]], orders)]
+        top = staging_height(layout, offsets[m:m + 2], max(int(lane.max()) for lane in lanes))
+        # A slot is its column at the staging height, other coordinates (d >= 3) kept:
+        # the first slide takes the next configuration's, later ones move along e1 only.
         slots, next_slots = (
             ends_of + (top - layout.frame.offset(ends_of))[:, None] * e2
             for ends_of in (columns, next_columns))
-        stages += [*risen[1:], columns, slots + lift[:, None] * e2,
-                   next_slots + lift[:, None] * e2, next_columns, back[-1], *back[-2::-1]]
-        names += [*rise_names, GATHER, LIFT, SLIDE, DROP, GATHER + '^-1',
-                  *(name + '^-1' for name in back_names[::-1])]
+        next_slot_projections = staging_slots(projections[m + 1], next_rank, layout.pitch)
+        passed = [next_slots + (staging_slots(projections[m + 1], order, layout.pitch)
+                                - next_slot_projections)[:, None] * e1
+                  for order in orders[:-1]] + [next_slots]
+        stages += [*risen[1:], columns]
+        names += [*rise_names, GATHER]
+        for before, after, lane in zip([slots, *passed[:-1]], passed, lanes):
+            lift = lane * layout.pitch
+            heights.update((top + lift).tolist())
+            stages += [before + lift[:, None] * e2, after + lift[:, None] * e2]
+            names += [LIFT, SLIDE]
+        stages += [next_columns, back[-1], *back[-2::-1]]
+        names += [DROP, GATHER + '^-1', *(name + '^-1' for name in back_names[::-1])]
         stages[-1] = configurations[m + 1]
         ends.append(len(stages) - 1)
     every = np.stack(stages)

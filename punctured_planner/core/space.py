@@ -170,7 +170,8 @@ class Workspace:
         inflation = 0.5 * self.required_clearance if self.has_bodies else 0.0
         return DiscLayout.from_radii(self.frame, self.obstacles,
                                      self.robot_radius + inflation,
-                                     self.obstacle_radii + inflation, self.min_spacing)
+                                     self.obstacle_radii + inflation, self.min_spacing,
+                                     self.bounds)
 
 
 def _checked_radii(robot_radius, obstacle_radius, obstacle_count):
