@@ -12,17 +12,20 @@ comes back outside. Figures per k: the share planned inside, the share refused,
 any other refusal, and for the refused the median distance beyond the wall as a
 share of the box's longest side; and the refined plan's length over the
 straight-line bound, planned without the walls' refusal in the frame the walls
-choose (core.frame.choose_frame) and in the default frame, side by side.
+choose (core.frame.choose_frame) and in the default frame, side by side; and for
+the fleets planned inside, their length inside the walls against that without them.
 
 Why the rest is refused, measured in the walls' frame as shares of the box's side
 (medians): the room between the staging height (above every pillar, by its zone
 or the slots' gap) and the wall e2 points to, against how far above the staging
 height the construction takes the fleet: its rise (core.discs.rise: the fleet
 stacked on the staging height) and its lanes (core.discs: about 2 sqrt k, a
-slot's pitch apart); and the staging line of k slots a pitch apart (its centres'
-span, (k - 1) g) against the room between the walls along e1 (their corners'
-extent along e1 less 2R). Both rooms are exact for an axis frame and upper bounds
-for an oblique one (the farthest corner, the corners' extent).
+slot's pitch apart, without walls; with them at most the lanes that fit below
+the far wall, discs.lane_limit, at least 2); and the staging line of k slots a
+pitch apart (its centres' span, (k - 1) g) against the room between the walls
+along e1 (their corners' extent along e1 less 2R). Both rooms are exact for an
+axis frame and upper bounds for an oblique one (the farthest corner, the corners'
+extent).
 
 Run alone: ``.venv/bin/python bench/hall.py [--quick]``.
 """
@@ -70,6 +73,7 @@ class Outcome:
     room: Room
     beyond: float = float('nan')
     seconds: float = float('nan')
+    inside_length: float = float('nan')
 
 
 def hall(fleet) -> np.ndarray:
@@ -133,7 +137,8 @@ def run_one(fleet) -> Outcome:
                        time.perf_counter() - begin)
     seconds = time.perf_counter() - begin
     assert inside(result.positions, bounds), f'k={fleet.k} seed={fleet.seed}: came back outside'
-    return Outcome(fleet.k, ErrorCode.NONE, *lengths, room, 0.0, seconds)
+    return Outcome(fleet.k, ErrorCode.NONE, *lengths, room, 0.0, seconds,
+                   length_ratio(result.positions, fleet.configurations))
 
 
 @dataclass
@@ -207,6 +212,7 @@ def summary(outcomes: list[Outcome]) -> list[str]:
     lined = sum(o.room.line <= o.room.width for o in small)
     both = sum(max(o.room.risen, o.room.lanes) <= o.room.room and o.room.line <= o.room.width
                for o in small)
+    inside_ = [o for o in small if o.code == ErrorCode.NONE]
     return [
         f'- Hall fleets k <= 40 planned inside the walls (15% margin): '
         f'{100 * planned / max(len(small), 1):.0f}% of {len(small)} (target >= 90%); every '
@@ -218,6 +224,10 @@ def summary(outcomes: list[Outcome]) -> list[str]:
         f'is {_median(small, "line")} of the side against {_median(small, "width")} between '
         f'the walls; it fits in {100 * lined / max(len(small), 1):.0f}% of the fleets, and '
         f'the line, the rise and the lanes all fit in {100 * both / max(len(small), 1):.0f}%.',
+        f'- The {len(inside_)} planned inside, length / straight line, median: '
+        f'{np.median([o.inside_length for o in inside_]):.2f} inside the walls (their lanes '
+        f"and the refinement's pull), {np.median([o.length for o in inside_]):.2f} without "
+        f'them in the same frame.',
     ]
 
 
