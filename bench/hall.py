@@ -21,7 +21,7 @@ or the slots' gap) and the wall e2 points to, against how far above the staging
 height the construction takes the fleet: its rise (core.discs.rise: the fleet
 stacked on the staging height) and its lanes (core.discs: about 2 sqrt k, a
 slot's pitch apart, without walls; with them at most the lanes that fit below
-the far wall, discs.lane_limit, at least 2); and the staging line of k slots a
+the far wall, discs.WallRoom, at least 2); and the staging line of k slots a
 pitch apart (its centres' span, (k - 1) g) against the room between the walls
 along e1 (their corners' extent along e1 less 2R). Both rooms are exact for an
 axis frame and upper bounds for an oblique one (the farthest corner, the corners'

@@ -382,7 +382,7 @@ def test_below_low_walls_the_robots_pass_in_the_lanes_that_fit():
     """
     Six robots reverse their order below a wall: one slide needs six lanes, the hall has three.
 
-    The construction then passes them in several slides of at most lane_limit lanes
+    The construction then passes them in several slides of at most WallRoom.lanes lanes
     (core.discs.passing_orders, doc/design.md section 17): inside the walls, bodies
     apart, waypoints exact, the same domain as without walls in the same frame.
     """
@@ -393,7 +393,7 @@ def test_below_low_walls_the_robots_pass_in_the_lanes_that_fit():
     bounds = np.array([[-0.3, 6.3], [-0.8, 3.8]])
     walled = Workspace(pillars, bounds=bounds, **options)
     free = Workspace(pillars, frame=walled.frame, **options)
-    assert walled.disc_layout.lane_limit == 3 and free.disc_layout.lane_limit is None
+    assert walled.disc_layout.walls.lanes == 3 and free.disc_layout.walls is None
     one_slide = plan(free, configurations, refine=False)
     assert len(one_slide.lanes) == 6
     assert smallest_leg_slack(one_slide.positions, bounds, 0.2).slack < -1.0
@@ -405,3 +405,26 @@ def test_below_low_walls_the_robots_pass_in_the_lanes_that_fit():
         np.testing.assert_array_equal(result.positions[result.waypoint_indices],
                                       configurations)
         assert result.domain_index == one_slide.domain_index
+
+
+def test_below_walls_the_staging_line_moves_into_the_room_between_them():
+    """
+    A fleet by the wall x = 0: centred on its mean projection, the staging line crosses it.
+
+    Below walls the slots' centre is clipped into the range the walls leave
+    (core.discs.staging_slots, WallRoom): the plan is inside and stays in its domain.
+    """
+    pillars = np.array([[2.0, 2.0], [4.0, 2.5]])
+    starts = np.array([[0.3, 0.5], [1.1, 0.5], [1.9, 0.5], [0.3, 1.3], [1.1, 1.3],
+                       [0.7, -0.3]])
+    configurations = np.stack([starts, starts[::-1]])
+    options = {'variant': 'discs', 'robot_radius': 0.2, 'obstacle_radius': 0.15}
+    bounds = np.array([[0.0, 6.0], [-0.6, 4.5]])
+    walled = Workspace(pillars, bounds=bounds, **options)
+    centred = plan(Workspace(pillars, frame=walled.frame, **options), configurations)
+    crossed = smallest_leg_slack(centred.positions, bounds, 0.2)
+    assert crossed.wall == Wall(axis=0, high=False) and crossed.slack < -0.5
+    result = plan(walled, configurations)
+    assert smallest_leg_slack(result.positions, bounds, 0.2).slack >= 0
+    assert result.min_gap > 0 and result.domain_index == centred.domain_index
+    np.testing.assert_array_equal(result.positions[result.waypoint_indices], configurations)

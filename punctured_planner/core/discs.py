@@ -47,7 +47,8 @@ The construction keeps the paper's skeleton, H(C_m), Gamma, H(C_{m+1})^-1
 * gather: every robot moves along e1 only, at its risen height, into the
   column of slot rank(x) (the hyperplane p = that slot); slots
   g = max(min_spacing, 2R + nu) apart along e1, centred on the mean robot
-  projection; rank orders robots by projection, ties by index. A slot is its
+  projection (below walls, moved into the room between them: staging_slots);
+  rank orders robots by projection, ties by index. A slot is its
   column at height top, the robot's coordinates across e1 and e2 kept
   (d >= 3): the staging line in the plane, the staging hyperplane h = top in
   3-D. Without pillars there is no rise and no height to clear: each segment's
@@ -60,7 +61,7 @@ The construction keeps the paper's skeleton, H(C_m), Gamma, H(C_{m+1})^-1
   along e2 within that column to its next base position. Robots whose
   slots keep their order share a lane (shared_lanes), so a segment needs as
   many lanes as its longest run of robots whose order reverses, not k. Below
-  walls that leave room for fewer lanes (lane_limit) the robots pass in several
+  walls that leave room for fewer lanes (WallRoom) the robots pass in several
   slides of at most that many lanes (passing_orders; doc/design.md section 17).
 
 Continuity and domains. On a stratum A_i the order of all k + r projections,
@@ -175,19 +176,46 @@ SIDESTEP, RISE, GATHER = 'sidestep', 'rise', 'gather'
 LIFT, SLIDE, DROP = 'lift', 'slide', 'drop'
 
 
-def lane_limit(frame: Frame, bounds: np.ndarray | None, robot_radius: float, top: float,
-               pitch: float) -> int | None:
+@dataclass(frozen=True)
+class WallRoom:
     """
-    Return how many lanes top + l g fit below the walls' far side, at least 2; None without walls.
+    What walls leave the construction (doc/design.md section 17).
 
-    The far side is the second farthest corner of the walls' box along e2, less R: in an
-    axis frame the far wall, in an oblique one the height beyond which the box narrows to
-    its farthest corner. Two lanes are the fewest that pass robots (passing_orders).
+    lanes: how many lanes top + l g fit below the walls' far side (at least 2, the
+    fewest that pass robots: passing_orders); low, high: the range of e1 projections
+    in which a robot's disc keeps the margin nu = R / 10 from the walls at the staging
+    height and at the highest of those lanes, where the staging line goes when it fits
+    (staging_slots).
     """
-    if bounds is None:
-        return None
-    ceiling = float(np.sort(frame.offset(box_corners(bounds)))[-2]) - robot_radius
-    return max(2, int(np.floor((ceiling - top) / pitch)) + 1)
+
+    lanes: int
+    low: float
+    high: float
+
+    @classmethod
+    def from_walls(cls, frame: Frame, bounds: np.ndarray, robot_radius: float, top: float,
+                   pitch: float) -> 'WallRoom':
+        """
+        Return the room below walls bounds (d, 2) for robots of radius R above height top.
+
+        The far side is the second farthest corner of the walls' box along e2, less R: in
+        an axis frame the far wall, in an oblique one the height beyond which the box
+        narrows to its farthest corner. The box is convex, so its section along e1 at a
+        height h is an interval whose ends are convex and concave in h: within the range
+        at both heights, a robot is within it at every height between.
+        """
+        ceiling = float(np.sort(frame.offset(box_corners(bounds)))[-2]) - robot_radius
+        lanes = max(2, int(np.floor((ceiling - top) / pitch)) + 1)
+        # Per axis a with e1_a != 0: l_a + R' <= (o + h e2 + t e1)_a <= h_a - R' bounds t,
+        # R' = R + nu: a staged robot keeps the robots' margin nu from the walls too, far
+        # above the rounding of an oblique frame (which put one 1e-16 beyond a wall).
+        axes = np.abs(frame.e1) > 0.0
+        keep = (1.0 + MARGIN) * robot_radius
+        inner = bounds[axes] + [keep, -keep]  # (a, 2): the walls, less R + nu
+        heights = np.array([top, top + (lanes - 1) * pitch])
+        base = frame.origin[axes] + heights[:, None] * frame.e2[axes]  # (2 heights, a)
+        ends = (inner.T[:, None, :] - base[None]) / frame.e1[axes]  # (2 walls, 2 heights, a)
+        return cls(lanes, float(ends.min(axis=0).max()), float(ends.max(axis=0).min()))
 
 
 @dataclass(frozen=True, eq=False)
@@ -201,8 +229,7 @@ class DiscLayout:
     height top (with pillars; without, each segment's staging_height), the least
     distance apart 2R + nu that every robot pair keeps, the pitch g of the slots
     and the lanes, the stack's reach D_p and fade (stacked_heights; module
-    docstring), and with walls the most lanes they leave room for (lane_limit;
-    None without walls).
+    docstring), and with walls the room they leave (WallRoom; None without walls).
     """
 
     frame: Frame
@@ -216,7 +243,7 @@ class DiscLayout:
     pitch: float
     pile_reach: float
     pile_fade: float
-    lane_limit: int | None
+    walls: WallRoom | None
 
     @classmethod
     def from_radii(cls, frame: Frame, obstacles: np.ndarray, robot_radius: float,
@@ -225,7 +252,7 @@ class DiscLayout:
         """
         Return the layout for pillars (r, d) of radii (r,), robots of radius R, walls bounds.
 
-        bounds (d, 2), or None for no walls, give lane_limit (lane_limit).
+        bounds (d, 2), or None for no walls, give the room the walls leave (WallRoom).
         """
         # A passing margin for every pillar size: mu_j = 0 (rho_j >= R, before) let bodies
         # graze. S stays 4R while w_j <= 1.9R (rho_j <= 0.8R); wider margins make
@@ -246,7 +273,8 @@ class DiscLayout:
         fade = np.sqrt(max(separation ** 2 - 2.0 * apart ** 2, 0.0))
         return cls(frame, obstacles, frame.project(obstacles), offsets, reach, ZONE * reach,
                    top, apart, pitch, np.sqrt(2.0) * pitch, float(fade),
-                   lane_limit(frame, bounds, robot_radius, top, pitch))
+                   None if bounds is None
+                   else WallRoom.from_walls(frame, bounds, robot_radius, top, pitch))
 
     def reaches(self, configuration: np.ndarray) -> np.ndarray:
         """
@@ -385,14 +413,22 @@ def staging_ranks(p: np.ndarray) -> np.ndarray:
     return rank
 
 
-def staging_slots(p: np.ndarray, rank: np.ndarray, pitch: float) -> np.ndarray:
+def staging_slots(p: np.ndarray, rank: np.ndarray, layout: DiscLayout) -> np.ndarray:
     """
     Return the (k,) projections of the slots for robots of projections p (k,).
 
-    Slot rank(x) lies (rank - (k - 1) / 2) g along e1 from the mean robot
-    projection.
+    Slot rank(x) lies (rank - (k - 1) / 2) g along e1 from the centre: the mean robot
+    projection, and below walls the nearest centre that keeps the whole staging line
+    in the walls' range (WallRoom), or the range's middle when the line is longer. A
+    clip into a range fixed per workspace and k, so continuous in p.
     """
-    return p.mean() + (rank - (len(rank) - 1) / 2) * pitch
+    half = 0.5 * (len(rank) - 1) * layout.pitch
+    centre = float(p.mean())
+    room = layout.walls
+    if room is not None:
+        centre = (0.5 * (room.low + room.high) if room.high - room.low < 2.0 * half
+                  else float(np.clip(centre, room.low + half, room.high - half)))
+    return centre + (rank - (len(rank) - 1) / 2) * layout.pitch
 
 
 def shared_lanes(first: np.ndarray, second: np.ndarray) -> np.ndarray:
@@ -508,7 +544,7 @@ def section(configurations: np.ndarray, layout: DiscLayout) -> DiscSection:
         names = [SIDESTEP] + [RISE] * (len(risen) - 2)
         rank = staging_ranks(p)
         # The gather moves along e1 only, into the slots' columns, at the risen heights.
-        columns = risen[-1] + (staging_slots(p, rank, layout.pitch) - p)[:, None] * e1
+        columns = risen[-1] + (staging_slots(p, rank, layout) - p)[:, None] * e1
         deformations.append((risen, names, rank, columns))
     stages, names, ends, heights = [configurations[0]], [''], [], set()
     for m in range(n - 1):
@@ -517,7 +553,8 @@ def section(configurations: np.ndarray, layout: DiscLayout) -> DiscSection:
         # Lane 0 is the staging height itself: its robots need no lift. Below walls the
         # robots may pass in several slides, each within the lanes the walls leave
         # (passing_orders), a lift along each robot's column between two.
-        orders = passing_orders(rank, next_rank, layout.lane_limit)
+        orders = passing_orders(rank, next_rank,
+                                None if layout.walls is None else layout.walls.lanes)
         lanes = [shared_lanes(before, after)
                  for before, after in zip([rank, *orders[:-1]], orders)]
         top = staging_height(layout, offsets[m:m + 2], max(int(lane.max()) for lane in lanes))
@@ -526,8 +563,8 @@ def section(configurations: np.ndarray, layout: DiscLayout) -> DiscSection:
         slots, next_slots = (
             ends_of + (top - layout.frame.offset(ends_of))[:, None] * e2
             for ends_of in (columns, next_columns))
-        next_slot_projections = staging_slots(projections[m + 1], next_rank, layout.pitch)
-        passed = [next_slots + (staging_slots(projections[m + 1], order, layout.pitch)
+        next_slot_projections = staging_slots(projections[m + 1], next_rank, layout)
+        passed = [next_slots + (staging_slots(projections[m + 1], order, layout)
                                 - next_slot_projections)[:, None] * e1
                   for order in orders[:-1]] + [next_slots]
         stages += [*risen[1:], columns]
