@@ -28,6 +28,8 @@ RADII = st.sampled_from([0.0, 0.05])
 CONTINUITY = 100.0
 # The change of input the continuity tests make, per coordinate.
 NUDGE = 1e-7
+# Where the continuity tests compare two motions: normalised time.
+TAU = np.linspace(0.0, 1.0, 3001)
 
 
 def workspace_for(obstacles, variant, radius):
@@ -99,8 +101,7 @@ def test_a_small_change_inside_a_domain_moves_the_refined_motion_little(request,
     moved = nudged(configurations, seed)
     before, after = refined(workspace, configurations), refined(workspace, moved)
     assume(same_cells(workspace, configurations, moved))
-    tau = np.linspace(0.0, 1.0, 3001)
-    change = np.abs(before.position(tau) - after.position(tau)).max()
+    change = np.abs(before.position(TAU) - after.position(TAU)).max()
     assert change <= CONTINUITY * NUDGE, change / NUDGE
 
 
@@ -140,6 +141,16 @@ def test_required_clearance_is_judged_on_the_refined_plan():
     met = Workspace(pillars, variant='discs', robot_radius=0.2, obstacle_radius=0.1,
                     required_clearance=0.3)
     assert plan(met, request).min_gap >= 0.3
+
+
+def motion_at(motion, tau):
+    """Return the (T, k, d) positions of a Refinement's motion at times tau (T,)."""
+    leg = np.clip(np.searchsorted(motion.times, tau, side='right') - 1, 0,
+                  motion.times.size - 2)
+    span = motion.times[leg + 1] - motion.times[leg]
+    f = np.where(span > 0, (tau - motion.times[leg]) / np.where(span > 0, span, 1.0), 0.0)
+    f = f[:, None, None]
+    return (1.0 - f) * motion.positions[leg] + f * motion.positions[leg + 1]
 
 
 def refined_with_walls(raw, bounds):
@@ -220,19 +231,10 @@ def test_with_walls_a_small_change_inside_a_domain_moves_the_refined_motion_litt
         raise
     assume(same_cells(workspace, configurations, moved))
     bounds = wall_bounds(before, 0.5, seed)
-    tau = np.linspace(0.0, 1.0, 3001)
-
-    def at(motion):
-        leg = np.clip(np.searchsorted(motion.times, tau, side='right') - 1, 0,
-                      motion.times.size - 2)
-        span = motion.times[leg + 1] - motion.times[leg]
-        f = np.where(span > 0, (tau - motion.times[leg]) / np.where(span > 0, span, 1.0), 0.0)
-        f = f[:, None, None]
-        return (1.0 - f) * motion.positions[leg] + f * motion.positions[leg + 1]
 
     def change(walls):
         first, second = refined_with_walls(before, walls), refined_with_walls(after, walls)
-        return np.abs(at(first) - at(second)).max()
+        return np.abs(motion_at(first, TAU) - motion_at(second, TAU)).max()
 
     with_walls = change(bounds)
     assert with_walls <= max(CONTINUITY * NUDGE, 2.0 * change(None)), with_walls / NUDGE

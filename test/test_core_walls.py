@@ -9,8 +9,8 @@ the priority of OUTSIDE_WORKSPACE among the other codes.
 
 from fractions import Fraction
 
-from core_strategies import lattice_requests, requests
-from hypothesis import given, HealthCheck, settings, strategies as st
+from core_strategies import lattice_requests, requests, same_cells
+from hypothesis import assume, given, HealthCheck, settings, strategies as st
 import numpy as np
 from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
 from punctured_planner.core.discs import section
@@ -21,7 +21,7 @@ from punctured_planner.core.validation import validate_configurations
 from punctured_planner.core.walls import (checked_bounds, first_outside, smallest_leg_slack,
                                           wall_slack)
 import pytest
-from test_core_refine import refined_with_walls
+from test_core_refine import CONTINUITY, motion_at, NUDGE, nudged, refined_with_walls, TAU
 
 PROPERTY = settings(max_examples=150, deadline=None,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
@@ -428,3 +428,46 @@ def test_below_walls_the_staging_line_moves_into_the_room_between_them():
     assert smallest_leg_slack(result.positions, bounds, 0.2).slack >= 0
     assert result.min_gap > 0 and result.domain_index == centred.domain_index
     np.testing.assert_array_equal(result.positions[result.waypoint_indices], configurations)
+
+
+def rows_in_a_hall(seed):
+    """
+    Return (pillars, configurations, bounds): rows of 3 - 8 discs of R = 0.2 about pillars.
+
+    From seed: a row below one to three pillars, then above them in a random order (often
+    with reversing runs the walls leave too few lanes for), then below again in another;
+    robots 0.85 m apart or more, the walls 0.05 - 0.5 m beyond the box of it all.
+    """
+    rng = np.random.default_rng(seed)
+    k, count = int(rng.integers(3, 9)), int(rng.integers(1, 4))
+    xs = np.sort(rng.choice(np.arange(2 * k), k, replace=False)) * 0.85
+    pillars = np.stack([np.arange(count) * 1.7 + rng.uniform(0.0, 0.5),
+                        rng.uniform(1.0, 2.0, count)], axis=1)
+    below = np.stack([xs, np.full(k, -0.5)], axis=1)
+    configurations = np.stack([below, np.stack([xs[rng.permutation(k)], np.full(k, 3.5)],
+                                               axis=1), below[rng.permutation(k)]])
+    points = np.concatenate([configurations.reshape(-1, 2), pillars])
+    spare = 0.2 + rng.uniform(0.05, 0.5)
+    return pillars, configurations, np.stack([points.min(axis=0) - spare,
+                                              points.max(axis=0) + spare], axis=1)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2 ** 31))
+def test_below_walls_a_small_change_inside_a_domain_moves_the_motion_little(seed):
+    """
+    Continuity of the walled motion, measured: a 1e-7 change moves it <= 100x that.
+
+    rows_in_a_hall: the lanes limited and the staging line moved by the walls; the
+    motion plan() judges (the walled construction, refined against the walls), before
+    and after a change of every coordinate that keeps every projection order.
+    """
+    pillars, configurations, bounds = rows_in_a_hall(seed)
+    walled = Workspace(pillars, variant='discs', robot_radius=0.2, obstacle_radius=0.15,
+                       bounds=bounds)
+    moved = nudged(configurations, seed)
+    assume(same_cells(walled, configurations, moved))
+    before, after = (refined_with_walls(walled_construction(walled, c), bounds)
+                     for c in (configurations, moved))
+    change = np.abs(motion_at(before, TAU) - motion_at(after, TAU)).max()
+    assert change <= CONTINUITY * NUDGE, change / NUDGE
