@@ -15,7 +15,8 @@ from hypothesis import assume, example, given, HealthCheck, settings, strategies
 import numpy as np
 from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
 from punctured_planner.core.discs import (MARGIN, passing_orders, rise, shared_lanes,
-                                          stacked_heights, STACKED_ROBOTS)
+                                          stacked_heights, STACKED_ROBOTS,
+                                          transposition_rounds)
 import pytest
 
 PROPERTY = settings(max_examples=120, deadline=None,
@@ -441,14 +442,21 @@ def test_passing_orders_end_in_the_next_order_each_slide_within_the_lane_limit(o
     Any two slot orders, the identity and the reversal among them: the walls' slides.
 
     Each order is a permutation of the slots, the last is the next order, and each
-    slide from the order before needs at most `limit` lanes (shared_lanes); the slides
-    are one exactly when one fits, as without walls (limit None).
+    slide from the order before needs at most `limit` lanes (shared_lanes) while no
+    later round would fit (the greedy's farthest, found in one pass: checked against
+    every later round); the slides are one exactly when one fits, as without walls
+    (limit None).
     """
     first, second = (np.array(order) for order in orders)
     steps = passing_orders(first, second, limit)
     np.testing.assert_array_equal(steps[-1], second)
+    rounds = transposition_rounds(first, second)
     for before, after in zip([first, *steps[:-1]], steps):
         np.testing.assert_array_equal(np.sort(after), np.arange(len(first)))
         assert shared_lanes(before, after).max() < limit
+        if len(steps) > 1:
+            at = next(i for i, order in enumerate(rounds) if np.array_equal(order, after))
+            assert all(shared_lanes(before, later).max() >= limit
+                       for later in rounds[at + 1:])
     assert (len(steps) == 1) == (shared_lanes(first, second).max() < limit)
     assert len(passing_orders(first, second, None)) == 1

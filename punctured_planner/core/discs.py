@@ -486,17 +486,22 @@ def passing_orders(first: np.ndarray, second: np.ndarray,
 
     One slide when its shared lanes are at most lane_limit (always without walls).
     Otherwise the orders of transposition_rounds, as few of them as greedily fit: from
-    each order the farthest later one whose slide needs at most lane_limit lanes. Every
-    round fits in two, so this ends; it depends on the two rank orders only.
+    each order the farthest later one whose slide needs at most lane_limit lanes. A
+    round swaps only pairs the wrong way round for second, so no pair is swapped back:
+    the pairs whose order differs from a given round's only grow, and so does the
+    longest run of them that reverses (the lanes), round after round. The farthest
+    round that fits is therefore the last of the first ones that do, found in one pass.
+    Every round fits in two, so this ends; it depends on the two rank orders only.
     """
     if lane_limit is None or shared_lanes(first, second).max() < lane_limit:
         return [second]
     rounds = transposition_rounds(first, second)
-    orders, current, start = [], first, 0
-    while start < len(rounds):
-        start = next(end for end in range(len(rounds), start, -1)
-                     if shared_lanes(current, rounds[end - 1]).max() < lane_limit)
-        current = rounds[start - 1]
+    orders, current, end = [], first, 0
+    while end < len(rounds):
+        end += 1  # one round always fits
+        while end < len(rounds) and shared_lanes(current, rounds[end]).max() < lane_limit:
+            end += 1
+        current = rounds[end - 1]
         orders.append(current)
     return orders
 
