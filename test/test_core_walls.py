@@ -452,22 +452,52 @@ def rows_in_a_hall(seed):
                                               points.max(axis=0) + spare], axis=1)
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.filter_too_much])
 @given(st.integers(0, 2 ** 31))
 def test_below_walls_a_small_change_inside_a_domain_moves_the_motion_little(seed):
     """
     Continuity of the walled motion, measured: a 1e-7 change moves it <= 100x that.
 
-    rows_in_a_hall: the lanes limited and the staging line moved by the walls; the
-    motion plan() judges (the walled construction, refined against the walls), before
-    and after a change of every coordinate that keeps every projection order.
+    rows_in_a_hall, kept where some segment passes in several slides (the staging line
+    moved by the walls too, mostly); the motion plan() judges (the walled construction,
+    refined against the walls), before and after a change of every coordinate that
+    keeps every projection order.
     """
     pillars, configurations, bounds = rows_in_a_hall(seed)
     walled = Workspace(pillars, variant='discs', robot_radius=0.2, obstacle_radius=0.15,
                        bounds=bounds)
     moved = nudged(configurations, seed)
     assume(same_cells(walled, configurations, moved))
-    before, after = (refined_with_walls(walled_construction(walled, c), bounds)
-                     for c in (configurations, moved))
+    constructions = [walled_construction(walled, c) for c in (configurations, moved)]
+    assume(constructions[0].leg_names.count('slide') > len(configurations) - 1)
+    before, after = (refined_with_walls(c, bounds) for c in constructions)
     change = np.abs(motion_at(before, TAU) - motion_at(after, TAU)).max()
     assert change <= CONTINUITY * NUDGE, change / NUDGE
+
+
+def test_the_walls_room_is_a_range_between_them_or_none():
+    """
+    The staging range (WallRoom): inside the walls where it applies, unbounded where not.
+
+    A lane above the far side must not empty the range of a robot that stages at lane 0;
+    a frame turned 1e-9 rad must not send the slots ten thousand km away (an empty
+    range divided by a tiny e1 component); in 3-D with e1 off the axes the robots'
+    coordinates across e1 and e2 move them along the walls' axes, so no range applies
+    (doc/design.md section 17).
+    """
+    turn = 7 * 2 * np.pi / 32
+    e2 = np.array([np.cos(turn), np.sin(turn)])
+    tilted = Workspace([[5.0, 1.0]], variant='discs', robot_radius=0.2, obstacle_radius=0.1,
+                       bounds=[[3.0, 8.5], [0.0, 1.45]],
+                       frame=((0.0, 0.0), e2[::-1] * [1, -1], e2))
+    construction = plan(tilted, [[[7.0, 0.5]], [[7.5, 0.4]]], refine=False)
+    assert smallest_leg_slack(construction.positions, tilted.bounds, 0.2).slack >= 0
+    barely = np.array([[np.cos(1e-9), np.sin(1e-9)], [-np.sin(1e-9), np.cos(1e-9)]])
+    turned = Workspace([[5.0, 1.0]], variant='discs', robot_radius=0.2, obstacle_radius=0.1,
+                       bounds=[[0.0, 10.0], [0.0, 4.16]], frame=((0.0, 0.0), *barely))
+    room = turned.disc_layout.walls
+    assert 0.2 < room.low < room.high < 9.8, room
+    moment = Workspace([[0.0, 0.0, 0.0], [0.0, 1.0, 1.0], [1.0, 0.0, 1.0]], variant='discs',
+                       robot_radius=0.2, obstacle_radius=0.1, bounds=[[-3.0, 4.0]] * 3)
+    assert np.count_nonzero(moment.frame.e1) == 3
+    assert (moment.disc_layout.walls.low, moment.disc_layout.walls.high) == (-np.inf, np.inf)

@@ -176,16 +176,30 @@ SIDESTEP, RISE, GATHER = 'sidestep', 'rise', 'gather'
 LIFT, SLIDE, DROP = 'lift', 'slide', 'drop'
 
 
+def _wall_section(frame: Frame, bounds: np.ndarray, keep: float,
+                  height: float) -> tuple[float, float]:
+    """
+    Return the e1 projections (low, high) at which o + height e2 + t e1 keeps `keep` from walls.
+
+    Per axis a with e1_a != 0, l_a + keep <= (o + height e2 + t e1)_a <= h_a - keep bounds
+    t; low > high when the line at that height misses the walls' box shrunk by keep.
+    """
+    axes = frame.e1 != 0.0
+    inner = bounds[axes] + [keep, -keep]  # (a, 2): the walls, less keep
+    base = frame.origin[axes] + height * frame.e2[axes]
+    ends = (inner - base[:, None]) / frame.e1[axes][:, None]
+    return float(ends.min(axis=1).max()), float(ends.max(axis=1).min())
+
+
 @dataclass(frozen=True)
 class WallRoom:
     """
     What walls leave the construction (doc/design.md section 17).
 
-    lanes: how many lanes top + l g fit below the walls' far side (at least 2, the
-    fewest that pass robots: passing_orders); low, high: the range of e1 projections
-    in which a robot's disc keeps the margin nu = R / 10 from the walls at the staging
-    height and at the highest of those lanes, where the staging line goes when it fits
-    (staging_slots).
+    lanes: how many lanes top + l g keep R + nu (the robots' margin nu = R / 10) from
+    the walls' far side, at least 2, the fewest that pass robots (passing_orders); low,
+    high: the range of e1 projections where the staging line goes when it fits
+    (staging_slots), unbounded where no range applies.
     """
 
     lanes: int
@@ -198,24 +212,29 @@ class WallRoom:
         """
         Return the room below walls bounds (d, 2) for robots of radius R above height top.
 
-        The far side is the second farthest corner of the walls' box along e2, less R: in
-        an axis frame the far wall, in an oblique one the height beyond which the box
-        narrows to its farthest corner. The box is convex, so its section along e1 at a
-        height h is an interval whose ends are convex and concave in h: within the range
-        at both heights, a robot is within it at every height between.
+        The far side is the second farthest corner of the walls' box along e2: in an axis
+        frame the far wall, in an oblique one the height beyond which the box narrows to
+        its farthest corner. The range is where a robot keeps R + nu from every wall at the
+        staging height and at the highest of those lanes (_wall_section); the box is
+        convex, so its section along e1 at a height is an interval whose ends are convex
+        and concave in the height, and within both ranges is within every one between. If
+        they do not meet (the two lanes passing needs may stand beyond the far side), the
+        range at the staging height alone; if that is empty too, or the robots'
+        coordinates across e1 and e2 (d >= 3, e1 not an axis) move them along the walls'
+        axes as well, none. The margin nu keeps an oblique frame's rounding (which put a
+        staged robot 1e-16 beyond a wall) far from the walls.
         """
-        ceiling = float(np.sort(frame.offset(box_corners(bounds)))[-2]) - robot_radius
-        lanes = max(2, int(np.floor((ceiling - top) / pitch)) + 1)
-        # Per axis a with e1_a != 0: l_a + R' <= (o + h e2 + t e1)_a <= h_a - R' bounds t,
-        # R' = R + nu: a staged robot keeps the robots' margin nu from the walls too, far
-        # above the rounding of an oblique frame (which put one 1e-16 beyond a wall).
-        axes = np.abs(frame.e1) > 0.0
         keep = (1.0 + MARGIN) * robot_radius
-        inner = bounds[axes] + [keep, -keep]  # (a, 2): the walls, less R + nu
-        heights = np.array([top, top + (lanes - 1) * pitch])
-        base = frame.origin[axes] + heights[:, None] * frame.e2[axes]  # (2 heights, a)
-        ends = (inner.T[:, None, :] - base[None]) / frame.e1[axes]  # (2 walls, 2 heights, a)
-        return cls(lanes, float(ends.min(axis=0).max()), float(ends.max(axis=0).min()))
+        ceiling = float(np.sort(frame.offset(box_corners(bounds)))[-2]) - keep
+        room = cls(max(2, int(np.floor((ceiling - top) / pitch)) + 1), -np.inf, np.inf)
+        if frame.e1.size > 2 and np.count_nonzero(frame.e1) > 1:
+            return room
+        low, high = _wall_section(frame, bounds, keep, top)
+        if low > high:
+            return room
+        top_lane = _wall_section(frame, bounds, keep, top + (room.lanes - 1) * pitch)
+        both = (max(low, top_lane[0]), min(high, top_lane[1]))
+        return cls(room.lanes, *(both if both[0] <= both[1] else (low, high)))
 
 
 @dataclass(frozen=True, eq=False)
@@ -229,7 +248,8 @@ class DiscLayout:
     height top (with pillars; without, each segment's staging_height), the least
     distance apart 2R + nu that every robot pair keeps, the pitch g of the slots
     and the lanes, the stack's reach D_p and fade (stacked_heights; module
-    docstring), and with walls the room they leave (WallRoom; None without walls).
+    docstring), and with walls (and pillars) the room they leave (WallRoom; None
+    without: there each segment stages in its fleet's middle, staging_height).
     """
 
     frame: Frame
@@ -273,7 +293,7 @@ class DiscLayout:
         fade = np.sqrt(max(separation ** 2 - 2.0 * apart ** 2, 0.0))
         return cls(frame, obstacles, frame.project(obstacles), offsets, reach, ZONE * reach,
                    top, apart, pitch, np.sqrt(2.0) * pitch, float(fade),
-                   None if bounds is None
+                   None if bounds is None or not len(obstacles)
                    else WallRoom.from_walls(frame, bounds, robot_radius, top, pitch))
 
     def reaches(self, configuration: np.ndarray) -> np.ndarray:
