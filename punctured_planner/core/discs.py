@@ -156,7 +156,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .frame import Frame
-from .walls import box_corners
+from .walls import box_corners, line_section
 
 # The push zone of pillar j in relative height u: full push for |u| <= FULL w_j,
 # none beyond ZONE w_j, linear between. The push to w_j lambda_j(u) then traces
@@ -174,21 +174,6 @@ STACKED_ROBOTS = 64
 
 SIDESTEP, RISE, GATHER = 'sidestep', 'rise', 'gather'
 LIFT, SLIDE, DROP = 'lift', 'slide', 'drop'
-
-
-def _wall_section(frame: Frame, bounds: np.ndarray, keep: float,
-                  height: float) -> tuple[float, float]:
-    """
-    Return the e1 projections (low, high) at which o + height e2 + t e1 keeps `keep` from walls.
-
-    Per axis a with e1_a != 0, l_a + keep <= (o + height e2 + t e1)_a <= h_a - keep bounds
-    t; low > high when the line at that height misses the walls' box shrunk by keep.
-    """
-    axes = frame.e1 != 0.0
-    inner = bounds[axes] + [keep, -keep]  # (a, 2): the walls, less keep
-    base = frame.origin[axes] + height * frame.e2[axes]
-    ends = (inner - base[:, None]) / frame.e1[axes][:, None]
-    return float(ends.min(axis=1).max()), float(ends.max(axis=1).min())
 
 
 @dataclass(frozen=True)
@@ -215,7 +200,7 @@ class WallRoom:
         The far side is the second farthest corner of the walls' box along e2: in an axis
         frame the far wall, in an oblique one the height beyond which the box narrows to
         its farthest corner. The range is where a robot keeps R + nu from every wall at the
-        staging height and at the highest of those lanes (_wall_section); the box is
+        staging height and at the highest of those lanes (walls.line_section); the box is
         convex, so its section along e1 at a height is an interval whose ends are convex
         and concave in the height, and within both ranges is within every one between. If
         they do not meet (the two lanes passing needs may stand beyond the far side), the
@@ -226,15 +211,14 @@ class WallRoom:
         """
         keep = (1.0 + MARGIN) * robot_radius
         ceiling = float(np.sort(frame.offset(box_corners(bounds)))[-2]) - keep
-        room = cls(max(2, int(np.floor((ceiling - top) / pitch)) + 1), -np.inf, np.inf)
-        if frame.e1.size > 2 and np.count_nonzero(frame.e1) > 1:
-            return room
-        low, high = _wall_section(frame, bounds, keep, top)
-        if low > high:
-            return room
-        top_lane = _wall_section(frame, bounds, keep, top + (room.lanes - 1) * pitch)
+        lanes = max(2, int(np.floor((ceiling - top) / pitch)) + 1)
+        low, high = line_section(bounds, frame.origin + top * frame.e2, frame.e1, keep)
+        if low > high or (frame.e1.size > 2 and np.count_nonzero(frame.e1) > 1):
+            return cls(lanes, -np.inf, np.inf)
+        top_lane = line_section(bounds, frame.origin + (top + (lanes - 1) * pitch) * frame.e2,
+                                frame.e1, keep)
         both = (max(low, top_lane[0]), min(high, top_lane[1]))
-        return cls(room.lanes, *(both if both[0] <= both[1] else (low, high)))
+        return cls(lanes, *(both if both[0] <= both[1] else (low, high)))
 
 
 @dataclass(frozen=True, eq=False)
@@ -527,6 +511,17 @@ def passing_orders(first: np.ndarray, second: np.ndarray,
 
 
 @dataclass(frozen=True)
+class _Staged:
+    """One configuration carried to its slots' columns: H(C) as section() needs it."""
+
+    risen: np.ndarray  # the sidestep and rise's stages, C first
+    names: list[str]  # their legs
+    rank: np.ndarray  # each robot's slot
+    slots: np.ndarray  # the slots' projections
+    columns: np.ndarray  # the gathered fleet, each robot in its slot's column
+
+
+@dataclass(frozen=True)
 class DiscSection:
     """The breakpoints of the whole motion, leg names, waypoints' indices, lanes' e2 offsets."""
 
@@ -568,13 +563,14 @@ def section(configurations: np.ndarray, layout: DiscLayout) -> DiscSection:
                                                                             layout.frame)
         names = [SIDESTEP] + [RISE] * (len(risen) - 2)
         rank = staging_ranks(p)
+        slots = staging_slots(p, rank, layout)
         # The gather moves along e1 only, into the slots' columns, at the risen heights.
-        columns = risen[-1] + (staging_slots(p, rank, layout) - p)[:, None] * e1
-        deformations.append((risen, names, rank, columns))
+        deformations.append(_Staged(risen, names, rank, slots,
+                                    risen[-1] + (slots - p)[:, None] * e1))
     stages, names, ends, heights = [configurations[0]], [''], [], set()
     for m in range(n - 1):
-        risen, rise_names, rank, columns = deformations[m]
-        back, back_names, next_rank, next_columns = deformations[m + 1]
+        here, there = deformations[m], deformations[m + 1]
+        rank, next_rank, columns, next_columns = here.rank, there.rank, here.columns, there.columns
         # Lane 0 is the staging height itself: its robots need no lift. Below walls the
         # robots may pass in several slides, each within the lanes the walls leave
         # (passing_orders), a lift along each robot's column between two.
@@ -588,19 +584,18 @@ def section(configurations: np.ndarray, layout: DiscLayout) -> DiscSection:
         slots, next_slots = (
             ends_of + (top - layout.frame.offset(ends_of))[:, None] * e2
             for ends_of in (columns, next_columns))
-        next_slot_projections = staging_slots(projections[m + 1], next_rank, layout)
         passed = [next_slots + (staging_slots(projections[m + 1], order, layout)
-                                - next_slot_projections)[:, None] * e1
+                                - there.slots)[:, None] * e1
                   for order in orders[:-1]] + [next_slots]
-        stages += [*risen[1:], columns]
-        names += [*rise_names, GATHER]
+        stages += [*here.risen[1:], columns]
+        names += [*here.names, GATHER]
         for before, after, lane in zip([slots, *passed[:-1]], passed, lanes):
             lift = lane * layout.pitch
             heights.update((top + lift).tolist())
             stages += [before + lift[:, None] * e2, after + lift[:, None] * e2]
             names += [LIFT, SLIDE]
-        stages += [next_columns, back[-1], *back[-2::-1]]
-        names += [DROP, GATHER + '^-1', *(name + '^-1' for name in back_names[::-1])]
+        stages += [next_columns, there.risen[-1], *there.risen[-2::-1]]
+        names += [DROP, GATHER + '^-1', *(name + '^-1' for name in there.names[::-1])]
         stages[-1] = configurations[m + 1]
         ends.append(len(stages) - 1)
     every = np.stack(stages)

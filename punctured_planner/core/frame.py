@@ -185,9 +185,9 @@ def choose_frame(obstacles: np.ndarray, bounds: np.ndarray | None = None,
     middle of the obstacles (_reach), an oblique frame only where it saves more than
     robot_radius of that climb over every axis frame; otherwise the first, the coordinate
     axes when they separate the obstacles (e1 = x, e2 = y). Ties go to the first, the
-    axis frames first. With no axis frame separating the obstacles, the moment-curve direction that
-    maximises the smallest gap between their projections (doc/design.md sections 4
-    and 17).
+    axis frames first. With no axis frame separating the obstacles, the moment-curve
+    direction that maximises the smallest gap between their projections
+    (doc/design.md sections 4 and 17).
     """
     r, d = obstacles.shape
     frames = [Frame(_origin(obstacles, bounds, e1), e1, e2)

@@ -99,6 +99,20 @@ def box_corners(bounds: np.ndarray) -> np.ndarray:
     return np.stack(np.meshgrid(*bounds, indexing='ij'), axis=-1).reshape(-1, bounds.shape[0])
 
 
+def line_section(bounds: np.ndarray, point: np.ndarray, direction: np.ndarray,
+                 keep: float) -> tuple[float, float]:
+    """
+    Return (low, high): the t at which point + t direction keeps `keep` from every wall.
+
+    Per axis a with direction_a != 0, l_a + keep <= point_a + t direction_a <= h_a - keep
+    bounds t; low > high when the line misses the box shrunk by keep.
+    """
+    axes = direction != 0.0
+    inner = bounds[axes] + [keep, -keep]  # (a, 2): the walls, less keep
+    ends = (inner - point[axes, None]) / direction[axes, None]
+    return float(ends.min(axis=1).max()), float(ends.max(axis=1).min())
+
+
 def _two_sum(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Return (s, e): s = fl(a + b) and its rounding error, a + b = s + e exactly (Knuth)."""
     total = a + b
