@@ -25,7 +25,10 @@ the far wall, discs.WallRoom, at least 2); and the staging line of k slots a
 pitch apart (its centres' span, (k - 1) g) against the room between the walls
 along e1 (their corners' extent along e1 less 2R). Both rooms are exact for an
 axis frame and upper bounds for an oblique one (the farthest corner, the corners'
-extent).
+extent). And the construction's own limit: whether the two lanes passing needs (at
+least) fit between the staging height and the walls' far side (the second farthest
+corner along e2, R + nu inside, as discs.WallRoom takes it), against the share then
+planned inside, for k <= 10 (beyond, the staging line is the limit).
 
 Run alone: ``.venv/bin/python bench/hall.py [--quick]``.
 """
@@ -37,7 +40,7 @@ from core_speed import grid_main, grid_report
 import numpy as np
 from peers import length_ratio
 from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
-from punctured_planner.core.discs import rise, section
+from punctured_planner.core.discs import MARGIN as BODY_MARGIN, rise, section
 from punctured_planner.core.walls import box_corners
 from refinement import each_fleet, PILLAR, RADIUS
 
@@ -60,6 +63,7 @@ class Room:
     lanes: float
     width: float
     line: float
+    two_lanes: bool
 
 
 @dataclass
@@ -113,8 +117,10 @@ def _room(fleet, workspace, side) -> Room:
                 for c, p, h in zip(fleet.configurations, frame.project(fleet.configurations),
                                    frame.offset(fleet.configurations)))
     lanes = float(section(fleet.configurations, layout).lane_heights.max())
+    far_side = float(np.sort(frame.offset(corners))[-2]) - (1 + BODY_MARGIN) * RADIUS
     return Room(room / side, (risen - layout.top) / side, (lanes - layout.top) / side,
-                width / side, (fleet.k - 1) * layout.pitch / side)
+                width / side, (fleet.k - 1) * layout.pitch / side,
+                far_side - layout.top >= layout.pitch)
 
 
 def run_one(fleet) -> Outcome:
@@ -207,12 +213,15 @@ def _cell(outcomes, names) -> str:
 def summary(outcomes: list[Outcome]) -> list[str]:
     """Return the headline: issue 19's target (>= 90% inside for k <= 40) against this run."""
     small = [o for o in outcomes if o.k <= 40]
-    planned = sum(o.code == ErrorCode.NONE for o in small)
+    planned = _inside_count(small)
     fits = sum(o.room.risen <= o.room.room for o in small)
     lined = sum(o.room.line <= o.room.width for o in small)
     both = sum(max(o.room.risen, o.room.lanes) <= o.room.room and o.room.line <= o.room.width
                for o in small)
     inside_ = [o for o in small if o.code == ErrorCode.NONE]
+    few = [o for o in outcomes if o.k <= 10]
+    roomy = [o for o in few if o.room.two_lanes]
+    tight = [o for o in few if not o.room.two_lanes]
     return [
         f'- Hall fleets k <= 40 planned inside the walls (15% margin): '
         f'{100 * planned / max(len(small), 1):.0f}% of {len(small)} (target >= 90%); every '
@@ -224,11 +233,20 @@ def summary(outcomes: list[Outcome]) -> list[str]:
         f'is {_median(small, "line")} of the side against {_median(small, "width")} between '
         f'the walls; it fits in {100 * lined / max(len(small), 1):.0f}% of the fleets, and '
         f'the line, the rise and the lanes all fit in {100 * both / max(len(small), 1):.0f}%.',
+        "- The construction's limit, k <= 10: the two lanes passing needs fit between the "
+        f'staging height and the far side in {len(roomy)} of {len(few)} fleets, and '
+        f'{_inside_count(roomy)} of them plan inside; of the {len(tight)} others, '
+        f"{_inside_count(tight)} (the refinement's pull).",
         f'- The {len(inside_)} planned inside, length / straight line, median: '
         f'{np.median([o.inside_length for o in inside_]):.2f} inside the walls (their lanes '
         f"and the refinement's pull), {np.median([o.length for o in inside_]):.2f} without "
         f'them in the same frame.',
     ]
+
+
+def _inside_count(outcomes) -> int:
+    """Return how many of outcomes were planned inside."""
+    return sum(o.code == ErrorCode.NONE for o in outcomes)
 
 
 def report(settings: Settings) -> list[str]:
