@@ -1,12 +1,14 @@
 """
-ROS-free math core: the sequential planner of Ipanaque Zapata & González, numpy only.
+ROS-free math core: the sequential planner of Ipanaque Zapata & González, on numpy and scipy.
 
 One module per idea of the paper: ``space`` (the space), ``frame`` (its frame),
 ``strata`` (cp and eps), ``deformations`` (D, S, phi), ``sections`` (Gamma,
 lanes, the composition of Remark 2.3 and the variant table), ``plan`` (the
 plan as breakpoints), ``certificate`` (exact clearance), ``timing`` (time
 parameterisation), ``complexity`` (domains and TC_n), ``pairs`` (index arrays
-of point pairs), ``walls`` (workspace bounds), ``validation`` and ``errors``.
+of point pairs), ``discs`` (the construction for disc robots among pillars),
+``refine`` (the refinement of every construction's motion), ``walls`` (workspace
+bounds), ``validation`` and ``errors``.
 The design, with the proofs, is doc/design.md.
 """
 

@@ -379,7 +379,7 @@ def rise(p: np.ndarray, h: np.ndarray, layout: DiscLayout, reach: np.ndarray) ->
     robot i within reach[i, j] of p(q_j), with that reach's full push and zone.
 
     Robot i rises by min(s, s_i), s_i = G_i - h_i its stop (stacked_heights;
-    top - h_min for all beyond STACKED_ROBOTS robots), for s from 0 to
+    max(0, top - h_min) for all beyond STACKED_ROBOTS robots), for s from 0 to
     T = max_i s_i. The breakpoints are s = 0 (after the sidestep), every stop,
     and every s in (0, T) where a robot in a pillar's shadow crosses an edge of
     its zone (module docstring).

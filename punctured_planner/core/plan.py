@@ -1,12 +1,16 @@
 """
 The plan: the sequential section sigma_{j_1..j_n} as exact breakpoints (paper, Section 4).
 
-`plan` runs, for every configuration C_m: the projection count cp(C_m), the
-desingularisation D (only below the top stratum), the spreading leg S
-(variant 'spread'), the projection phi onto the axis; then composes Gamma
-between consecutive axis configurations as in Remark 2.3. Every leg is linear
-and all robots switch legs together, so the motion is the piecewise-linear
-interpolation of its breakpoints, stored exactly.
+`plan` validates the configurations and takes every C_m's projection count
+cp(C_m); then builds the variant's construction. For 'paper' and 'spread':
+the desingularisation D (only below the top stratum), the spreading leg S
+('spread'), the projection phi onto the axis, and Gamma between consecutive
+axis configurations as in Remark 2.3. For 'discs': core.discs.section (the same
+skeleton onto a staging line above the pillars). The motion is then refined
+(core.refine, unless refine=False), certified (required_clearance) and checked
+against the walls. Every leg is linear and all robots switch legs together, so
+the motion is the piecewise-linear interpolation of its breakpoints, stored
+exactly.
 """
 
 from dataclasses import dataclass
@@ -54,7 +58,7 @@ class Samples:
 
 class Plan:
     """
-    A synchronous collision-free motion through C_1..C_n, stored as breakpoints.
+    A synchronous motion through C_1..C_n, stored as breakpoints; min_gap is its exact gap.
 
     Built by one of its named constructors: ``axis`` (the paper's and the spread
     variant's construction), ``discs`` (the discs variant's) or ``refined`` (a
@@ -183,7 +187,7 @@ class Plan:
     @cached_property
     def clearance_bound(self) -> float | None:
         """
-        Return a lower bound on min_clearance for the 'spread' variant (None for 'paper').
+        Return a lower bound on min_clearance for the 'spread' variant (None for the others).
 
         bound = min(s / (k + r) if some C_m is singular else s, g, lane_spacing):
         s is the input separation; D moves the robots of a singular C_m by less
@@ -194,7 +198,7 @@ class Plan:
         """
         if self.variant != 'spread' or self._spacing is None:
             return None
-        n, k = self.configurations.shape[:2]
+        k = self.configurations.shape[1]
         singular = np.any(self.projection_counts < k + self.workspace.obstacle_count)
         separation = self.input_separation
         if singular:

@@ -105,7 +105,9 @@ def line_section(bounds: np.ndarray, point: np.ndarray, direction: np.ndarray,
     Return (low, high): the t at which point + t direction keeps `keep` from every wall.
 
     Per axis a with direction_a != 0, l_a + keep <= point_a + t direction_a <= h_a - keep
-    bounds t; low > high when the line misses the box shrunk by keep.
+    bounds t; low > high when those bounds leave no t. The walls of an axis the line
+    runs parallel to are as far from every point of it, so they bound no t and are not
+    looked at: a line beyond them gets the range the other walls leave.
     """
     axes = direction != 0.0
     inner = bounds[axes] + [keep, -keep]  # (a, 2): the walls, less keep
