@@ -475,6 +475,32 @@ def test_below_walls_a_small_change_inside_a_domain_moves_the_motion_little(seed
     assert change <= CONTINUITY * NUDGE, change / NUDGE
 
 
+def test_below_walls_without_pillars_the_lanes_stand_between_them():
+    """
+    Six robots reverse in an aisle 2.4 m wide without a pillar: six centred lanes leave it.
+
+    Without pillars the lanes may stand anywhere between the walls (WallRoom.floor and
+    ceiling): the staging height is clipped between them and the robots pass in the
+    lanes that fit (doc/design.md section 17): inside, bodies apart, waypoints exact,
+    the same domain as without walls.
+    """
+    starts = np.stack([np.linspace(-3.5, 3.5, 6), np.zeros(6)], axis=1)
+    configurations = np.stack([starts, starts[::-1]])
+    options = {'variant': 'discs', 'robot_radius': 0.2, 'obstacle_radius': 0.05}
+    bounds = np.array([[-5.0, 5.0], [-1.2, 1.2]])
+    walled = Workspace(np.zeros((0, 2)), bounds=bounds, **options)
+    centred = plan(Workspace(np.zeros((0, 2)), **options), configurations, refine=False)
+    assert len(centred.lanes) == 6 and walled.disc_layout.walls.lanes == 4
+    assert smallest_leg_slack(centred.positions, bounds, 0.2).slack < -0.2
+    for refine in (False, True):
+        result = plan(walled, configurations, refine=refine)
+        assert smallest_leg_slack(result.positions, bounds, 0.2).slack >= 0
+        assert len(result.lanes) <= 4 and result.leg_names.count('slide') > 1
+        assert result.min_gap > 0 and result.domain_index == centred.domain_index
+        np.testing.assert_array_equal(result.positions[result.waypoint_indices],
+                                      configurations)
+
+
 def test_the_walls_room_is_a_range_between_them_or_none():
     """
     The staging range (WallRoom): inside the walls where it applies, unbounded where not.

@@ -53,7 +53,7 @@ The construction keeps the paper's skeleton, H(C_m), Gamma, H(C_{m+1})^-1
   (d >= 3): the staging line in the plane, the staging hyperplane h = top in
   3-D. Without pillars there is no rise and no height to clear: each segment's
   staging height centres its lanes on the mean e2 offset of its two
-  configurations (staging_height).
+  configurations (staging_height; below walls, clipped between them).
 * Gamma between base configurations (the paper's section, equation 3.1, with
   shared lanes): every robot moves along e2 within its column to its lane
   top + l g (lane 0 is the staging height itself), slides at that height to
@@ -181,26 +181,32 @@ class WallRoom:
     """
     What walls leave the construction (doc/design.md section 17).
 
-    lanes: how many lanes top + l g keep R + nu (the robots' margin nu = R / 10) from
+    lanes: how many lanes floor + l g keep R + nu (the robots' margin nu = R / 10) from
     the walls' far side, at least 2, the fewest that pass robots (passing_orders); low,
     high: the range of e1 projections where the staging line goes when it fits
-    (staging_slots), unbounded where no range applies.
+    (staging_slots), unbounded where no range applies; floor, ceiling: the lowest and
+    the highest height a lane may take (floor the staging height top with pillars;
+    without, the staging height moves between them, staging_height).
     """
 
     lanes: int
     low: float
     high: float
+    floor: float
+    ceiling: float
 
     @classmethod
-    def from_walls(cls, frame: Frame, bounds: np.ndarray, robot_radius: float, top: float,
-                   pitch: float) -> 'WallRoom':
+    def from_walls(cls, frame: Frame, bounds: np.ndarray, robot_radius: float,
+                   top: float | None, pitch: float) -> 'WallRoom':
         """
         Return the room below walls bounds (d, 2) for robots of radius R above height top.
 
         The far side is the second farthest corner of the walls' box along e2: in an axis
         frame the far wall, in an oblique one the height beyond which the box narrows to
-        its farthest corner. The range is where a robot keeps R + nu from every wall at the
-        staging height and at the highest of those lanes (walls.line_section); the box is
+        its farthest corner. Without pillars (top None) the lanes may stand anywhere
+        between the near side (the second nearest corner, likewise) and the far side,
+        each R + nu inside. The range is where a robot keeps R + nu from every wall at the
+        lowest lane and at the highest of those lanes (walls.line_section); the box is
         convex, so its section along e1 at a height is an interval whose ends are convex
         and concave in the height, and within both ranges is within every one between. If
         they do not meet (the two lanes passing needs may stand beyond the far side), the
@@ -210,15 +216,18 @@ class WallRoom:
         staged robot 1e-16 beyond a wall) far from the walls.
         """
         keep = (1.0 + MARGIN) * robot_radius
-        ceiling = float(np.sort(frame.offset(box_corners(bounds)))[-2]) - keep
-        lanes = max(2, int(np.floor((ceiling - top) / pitch)) + 1)
-        low, high = line_section(bounds, frame.origin + top * frame.e2, frame.e1, keep)
+        corners = np.sort(frame.offset(box_corners(bounds)))
+        floor = corners[1] + keep if top is None else top
+        ceiling = float(corners[-2]) - keep
+        lanes = max(2, int(np.floor((ceiling - floor) / pitch)) + 1)
+        low, high = line_section(bounds, frame.origin + floor * frame.e2, frame.e1, keep)
         if low > high or (frame.e1.size > 2 and np.count_nonzero(frame.e1) > 1):
-            return cls(lanes, -np.inf, np.inf)
-        top_lane = line_section(bounds, frame.origin + (top + (lanes - 1) * pitch) * frame.e2,
+            return cls(lanes, -np.inf, np.inf, floor, ceiling)
+        top_lane = line_section(bounds,
+                                frame.origin + (floor + (lanes - 1) * pitch) * frame.e2,
                                 frame.e1, keep)
         both = (max(low, top_lane[0]), min(high, top_lane[1]))
-        return cls(lanes, *(both if both[0] <= both[1] else (low, high)))
+        return cls(lanes, *(both if both[0] <= both[1] else (low, high)), floor, ceiling)
 
 
 @dataclass(frozen=True, eq=False)
@@ -232,8 +241,7 @@ class DiscLayout:
     height top (with pillars; without, each segment's staging_height), the least
     distance apart 2R + nu that every robot pair keeps, the pitch g of the slots
     and the lanes, the stack's reach D_p and fade (stacked_heights; module
-    docstring), and with walls (and pillars) the room they leave (WallRoom; None
-    without: there each segment stages in its fleet's middle, staging_height).
+    docstring), and with walls the room they leave (WallRoom; None without).
     """
 
     frame: Frame
@@ -277,8 +285,9 @@ class DiscLayout:
         fade = np.sqrt(max(separation ** 2 - 2.0 * apart ** 2, 0.0))
         return cls(frame, obstacles, frame.project(obstacles), offsets, reach, ZONE * reach,
                    top, apart, pitch, np.sqrt(2.0) * pitch, float(fade),
-                   None if bounds is None or not len(obstacles)
-                   else WallRoom.from_walls(frame, bounds, robot_radius, top, pitch))
+                   None if bounds is None
+                   else WallRoom.from_walls(frame, bounds, robot_radius,
+                                            top if len(obstacles) else None, pitch))
 
     def reaches(self, configuration: np.ndarray) -> np.ndarray:
         """
@@ -539,11 +548,20 @@ def staging_height(layout: DiscLayout, offsets: np.ndarray, top_lane: int) -> fl
     configurations, top_lane its highest lane. Without pillars no height needs
     clearing, and the lanes are centred on the mean offset: a continuous
     function of the two configurations, near the fleet wherever the frame's
-    origin lies (the axis, h = 0, can be far from it).
+    origin lies (the axis, h = 0, can be far from it). Below walls that height is
+    clipped between the room's floor and its ceiling less the lanes (WallRoom), or
+    is the middle where the lanes do not fit: a clip into a range fixed per
+    workspace and lane count, so still continuous.
     """
     if layout.reach.size:
         return layout.top
-    return float(offsets.mean()) - 0.5 * top_lane * layout.pitch
+    height = float(offsets.mean()) - 0.5 * top_lane * layout.pitch
+    room = layout.walls
+    if room is None:
+        return height
+    highest = room.ceiling - top_lane * layout.pitch
+    return (0.5 * (room.floor + highest) if highest < room.floor
+            else float(np.clip(height, room.floor, highest)))
 
 
 def section(configurations: np.ndarray, layout: DiscLayout) -> DiscSection:
