@@ -501,6 +501,51 @@ def test_below_walls_without_pillars_the_lanes_stand_between_them():
                                       configurations)
 
 
+def rows_in_an_aisle(seed):
+    """
+    Return (configurations, bounds): rows of 3 - 8 discs of R = 0.2 reordering in an aisle.
+
+    From seed: three rows of robots 0.85 m or more apart along x, each a random
+    permutation of the last, the rows' heights scattered by up to 0.5 m; walls 0.05 - 0.5
+    m beyond them along x, an aisle 1.3 - 2.5 m high along y (two to five lanes), no pillar.
+    """
+    rng = np.random.default_rng(seed)
+    k = int(rng.integers(3, 9))
+    xs = np.sort(rng.choice(np.arange(2 * k), k, replace=False)) * 0.85
+    rows = [np.stack([xs[rng.permutation(k)], rng.uniform(-0.25, 0.25, k)], axis=1)
+            for _ in range(3)]
+    height = rng.uniform(1.3, 2.5)
+    spare = 0.2 + rng.uniform(0.05, 0.5)
+    bounds = np.array([[xs[0] - spare, xs[-1] + spare], [-0.5 * height, 0.5 * height]])
+    return np.stack(rows), bounds
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.filter_too_much])
+@given(st.integers(0, 2 ** 31))
+def test_in_an_aisle_without_pillars_the_motion_is_inside_and_continuous(seed):
+    """
+    Below walls without pillars: inside, waypoints exact, and a 1e-7 change moves it little.
+
+    rows_in_an_aisle, kept where some segment passes in several slides (its staging
+    height clipped between the walls, mostly): the walled construction and its
+    refinement stay inside, bodies apart, and the refined motion moves <= 100x the
+    change of every coordinate (doc/design.md section 17, *Without pillars*).
+    """
+    configurations, bounds = rows_in_an_aisle(seed)
+    walled = Workspace(np.zeros((0, 2)), variant='discs', robot_radius=0.2,
+                       obstacle_radius=0.0, bounds=bounds)
+    moved = nudged(configurations, seed)
+    assume(same_cells(walled, configurations, moved))
+    constructions = [walled_construction(walled, c) for c in (configurations, moved)]
+    assume(constructions[0].leg_names.count('slide') > len(configurations) - 1)
+    result = plan(walled, configurations)
+    assert smallest_leg_slack(result.positions, bounds, 0.2).slack >= 0 and result.min_gap > 0
+    np.testing.assert_array_equal(result.positions[result.waypoint_indices], configurations)
+    before, after = (refined_with_walls(c, bounds) for c in constructions)
+    change = np.abs(motion_at(before, TAU) - motion_at(after, TAU)).max()
+    assert change <= CONTINUITY * NUDGE, change / NUDGE
+
+
 def test_the_walls_room_is_a_range_between_them_or_none():
     """
     The staging range (WallRoom): inside the walls where it applies, unbounded where not.
