@@ -378,6 +378,24 @@ def test_the_walls_choose_the_frame_with_the_most_room_beyond_the_obstacles():
     assert refused.value.wall == Wall(1, True), str(refused.value)
 
 
+def test_equal_rooms_go_to_the_first_frame_and_rounding_separates_no_pillars():
+    """
+    Ties of rooms go to the axis frames; rounding alone separates no pillars.
+
+    A tie goes to the first frame whatever qhull's rounding, and a frame that tells two
+    pillars apart only by rounding is no candidate (doc/design.md section 4). Every direction through the one pillar at a square hall's centre halves it; e1
+    across the line of two pillars gives them projections 4e-16 apart.
+    """
+    bodies = {'variant': 'discs', 'robot_radius': 0.2, 'obstacle_radius': 0.15}
+    for shift in (0.0, 0.1, 7.0):
+        hall = np.array([[-10.0 + shift, 10.0 + shift], [-10.0, 10.0]])
+        np.testing.assert_array_equal(Workspace([[shift, 0.0]], bounds=hall,
+                                                **bodies).frame.e2, [0.0, 1.0])
+    diagonal = Workspace([[1.0, 1.0], [3.0, 3.0]], bounds=[[-5.0, 5.0], [-5.0, 5.0]],
+                         **bodies)
+    assert np.diff(np.sort(diagonal.frame.project(diagonal.obstacles)))[0] > 0.1
+
+
 def test_below_low_walls_the_robots_pass_in_the_lanes_that_fit():
     """
     Six robots reverse their order below a wall: one slide needs six lanes, the hall has three.

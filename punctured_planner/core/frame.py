@@ -14,6 +14,7 @@ import numpy as np
 import numpy.typing as npt
 from scipy.spatial import ConvexHull, QhullError
 
+from .certificate import RELATIVE_RESOLUTION
 from .errors import ErrorCode, PlanningError
 from .walls import box_corners
 
@@ -21,6 +22,10 @@ _ORTHONORMAL_TOLERANCE = 1e-9
 # For bodies in the plane, the directions e2 may take: this many evenly spaced angles, the
 # four axis directions among them (doc/design.md section 4).
 _OBLIQUE_DIRECTIONS = 32
+# Rooms (_room) within this share of the most are a tie, which the first frame wins: qhull
+# rounds, and gave an oblique frame 200.00000000000003 against the axis frames' 200.0 in a
+# 20 x 20 hall whose pillar every direction halves.
+_ROOM_TIE = 1e-9
 
 
 @dataclass(frozen=True, eq=False)
@@ -192,11 +197,16 @@ def choose_frame(obstacles: np.ndarray, bounds: np.ndarray | None = None,
     r, d = obstacles.shape
     frames = [Frame(_origin(obstacles, bounds, e1), e1, e2)
               for e1, e2 in _frame_directions(d, oblique=oblique and r > 0)]
-    # Distinct projections, taken as the workspace takes them (Frame.project).
+    # Distinct projections, taken as the workspace takes them (Frame.project): exact in an
+    # axis frame, and in an oblique one farther apart than their rounding (an e1 across the
+    # line of two pillars once told them apart by 4e-16).
+    resolution = RELATIVE_RESOLUTION * float(np.abs(obstacles).max(initial=0.0))
     frames = [frame for frame in frames
-              if r < 2 or np.all(np.diff(np.sort(frame.project(obstacles))) > 0)]
+              if r < 2 or np.all(np.diff(np.sort(frame.project(obstacles)))
+                                 > (0.0 if _is_axis(frame) else resolution))]
     if frames and r > 0 and bounds is not None:
-        return frames[int(np.argmax([_room(obstacles, bounds, frame.e2) for frame in frames]))]
+        rooms = np.array([_room(obstacles, bounds, frame.e2) for frame in frames])
+        return frames[int(np.argmax(rooms >= rooms.max() * (1.0 - _ROOM_TIE)))]
     if frames and r > 0 and oblique:
         # The axis frames keep the request's own coordinates (lanes along the building's
         # walls, exact projections): an oblique one must pay for itself (design section 4).
