@@ -383,8 +383,9 @@ def test_equal_rooms_go_to_the_first_frame_and_rounding_separates_no_pillars():
     Ties of rooms go to the axis frames; rounding alone separates no pillars.
 
     A tie goes to the first frame whatever qhull's rounding, and a frame that tells two
-    pillars apart only by rounding is no candidate (doc/design.md section 4). Every direction through the one pillar at a square hall's centre halves it; e1
-    across the line of two pillars gives them projections 4e-16 apart.
+    pillars apart only by rounding is no candidate (doc/design.md section 4). Every
+    direction through the one pillar at a square hall's centre halves it; e1 across the
+    line of two pillars gives them projections 4e-16 apart.
     """
     bodies = {'variant': 'discs', 'robot_radius': 0.2, 'obstacle_radius': 0.15}
     for shift in (0.0, 0.1, 7.0):
