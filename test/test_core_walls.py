@@ -397,6 +397,20 @@ def test_equal_rooms_go_to_the_first_frame_and_rounding_separates_no_pillars():
     assert np.diff(np.sort(diagonal.frame.project(diagonal.obstacles)))[0] > 0.1
 
 
+def test_without_an_axis_frame_the_walls_still_turn_e2_towards_the_room():
+    """
+    Without an axis frame, e2 turns to the side of the walls with the more room.
+
+    No axis frame separates three obstacles on two axes; the moment-curve frame's e2
+    turns to the side with the more room beyond them (doc/design.md section 4).
+    """
+    obstacles = np.array([[0.0, 0.0], [0.0, 3.0], [3.0, 0.0]])
+    for bounds, far in (([[-1.0, 4.0], [-1.0, 10.0]], 1.0), ([[-1.0, 4.0], [-8.0, 4.0]], -1.0)):
+        frame = Workspace(obstacles, variant='paper', bounds=bounds).frame
+        assert np.count_nonzero(frame.e1) == 2  # neither axis separates them
+        assert np.sign(frame.e2[1]) == far, frame.e2
+
+
 def test_below_low_walls_the_robots_pass_in_the_lanes_that_fit():
     """
     Six robots reverse their order below a wall: one slide needs six lanes, the hall has three.

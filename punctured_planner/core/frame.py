@@ -191,8 +191,8 @@ def choose_frame(obstacles: np.ndarray, bounds: np.ndarray | None = None,
     robot_radius of that climb over every axis frame; otherwise the first, the coordinate
     axes when they separate the obstacles (e1 = x, e2 = y). Ties go to the first, the
     axis frames first. With no axis frame separating the obstacles, the moment-curve
-    direction that maximises the smallest gap between their projections
-    (doc/design.md sections 4 and 17).
+    direction that maximises the smallest gap between their projections, e2 across it
+    (with walls, the way with the more room) (doc/design.md sections 4 and 17).
     """
     r, d = obstacles.shape
     frames = [Frame(_origin(obstacles, bounds, e1), e1, e2)
@@ -219,7 +219,12 @@ def choose_frame(obstacles: np.ndarray, bounds: np.ndarray | None = None,
     directions = _moment_curve_directions(d, count)
     gaps = np.diff(np.sort(obstacles @ directions.T, axis=0), axis=0).min(axis=0)
     e1 = directions[int(np.argmax(gaps))]
-    return Frame(_origin(obstacles, bounds, e1), e1, _complement_direction(e1))
+    e2 = _complement_direction(e1)
+    # With walls, towards the more room, as every other frame is chosen.
+    if bounds is not None and (_room(obstacles, bounds, -e2)
+                               > _room(obstacles, bounds, e2) * (1.0 + _ROOM_TIE)):
+        e2 = -e2
+    return Frame(_origin(obstacles, bounds, e1), e1, e2)
 
 
 def checked_frame(frame: Frame | tuple, dimension: int) -> Frame:
