@@ -27,7 +27,7 @@ along e1 (their corners' extent along e1 less 2R). Both rooms are exact for an
 axis frame and upper bounds for an oblique one (the farthest corner, the corners'
 extent). And the construction's own limit: whether the two lanes passing needs (at
 least) fit between the staging height and the walls' far side (the second farthest
-corner along e2, R + nu inside, as discs.WallRoom takes it), against the share then
+corner along e2, R + nu inside: discs.WallRoom's ceiling), against the share then
 planned inside, for k <= 10 (beyond, the staging line is the limit).
 
 Run alone: ``.venv/bin/python bench/hall.py [--quick]``.
@@ -40,7 +40,7 @@ from core_speed import grid_main, grid_report
 import numpy as np
 from peers import length_ratio
 from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
-from punctured_planner.core.discs import MARGIN as BODY_MARGIN, rise, section
+from punctured_planner.core.discs import rise, section
 from punctured_planner.core.walls import box_corners
 from refinement import each_fleet, PILLAR, RADIUS
 
@@ -117,10 +117,9 @@ def _room(fleet, workspace, side) -> Room:
                 for c, p, h in zip(fleet.configurations, frame.project(fleet.configurations),
                                    frame.offset(fleet.configurations)))
     lanes = float(section(fleet.configurations, layout).lane_heights.max())
-    far_side = float(np.sort(frame.offset(corners))[-2]) - (1 + BODY_MARGIN) * RADIUS
     return Room(room / side, (risen - layout.top) / side, (lanes - layout.top) / side,
                 width / side, (fleet.k - 1) * layout.pitch / side,
-                far_side - layout.top >= layout.pitch)
+                layout.walls.ceiling - layout.top >= layout.pitch)
 
 
 def run_one(fleet) -> Outcome:

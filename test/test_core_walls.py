@@ -510,14 +510,15 @@ def test_below_walls_a_small_change_inside_a_domain_moves_the_motion_little(seed
 
 def test_below_walls_without_pillars_the_lanes_stand_between_them():
     """
-    Six robots reverse in an aisle 2.4 m wide without a pillar: six centred lanes leave it.
+    Six robots reverse by the wall of an aisle 2.4 m wide without a pillar: lanes leave it.
 
     Without pillars the lanes may stand anywhere between the walls (WallRoom.floor and
     ceiling): the staging height is clipped between them and the robots pass in the
     lanes that fit (doc/design.md section 17): inside, bodies apart, waypoints exact,
     the same domain as without walls.
     """
-    starts = np.stack([np.linspace(-3.5, 3.5, 6), np.zeros(6)], axis=1)
+    # By the wall y = 1.2: even four lanes centred on the fleet would cross it.
+    starts = np.stack([np.linspace(-3.5, 3.5, 6), np.full(6, 0.8)], axis=1)
     configurations = np.stack([starts, starts[::-1]])
     options = {'variant': 'discs', 'robot_radius': 0.2, 'obstacle_radius': 0.05}
     bounds = np.array([[-5.0, 5.0], [-1.2, 1.2]])

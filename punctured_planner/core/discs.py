@@ -210,14 +210,14 @@ class WallRoom:
         convex, so its section along e1 at a height is an interval whose ends are convex
         and concave in the height, and within both ranges is within every one between. If
         they do not meet (the two lanes passing needs may stand beyond the far side), the
-        range at the staging height alone; if that is empty too, or the robots'
+        range at the lowest lane alone; if that is empty too, or the robots'
         coordinates across e1 and e2 (d >= 3, e1 not an axis) move them along the walls'
         axes as well, none. The margin nu keeps an oblique frame's rounding (which put a
         staged robot 1e-16 beyond a wall) far from the walls.
         """
         keep = (1.0 + MARGIN) * robot_radius
         corners = np.sort(frame.offset(box_corners(bounds)))
-        floor = corners[1] + keep if top is None else top
+        floor = float(corners[1]) + keep if top is None else top
         ceiling = float(corners[-2]) - keep
         lanes = max(2, int(np.floor((ceiling - floor) / pitch)) + 1)
         low, high = line_section(bounds, frame.origin + floor * frame.e2, frame.e1, keep)
