@@ -526,7 +526,6 @@ class _Staged:
     risen: np.ndarray  # the sidestep and rise's stages, C first
     names: list[str]  # their legs
     rank: np.ndarray  # each robot's slot
-    slots: np.ndarray  # the slots' projections
     columns: np.ndarray  # the gathered fleet, each robot in its slot's column
 
 
@@ -583,7 +582,7 @@ def section(configurations: np.ndarray, layout: DiscLayout) -> DiscSection:
         rank = staging_ranks(p)
         slots = staging_slots(p, rank, layout)
         # The gather moves along e1 only, into the slots' columns, at the risen heights.
-        deformations.append(_Staged(risen, names, rank, slots,
+        deformations.append(_Staged(risen, names, rank,
                                     risen[-1] + (slots - p)[:, None] * e1))
     stages, names, ends, heights = [configurations[0]], [''], [], set()
     for m in range(n - 1):
@@ -602,8 +601,9 @@ def section(configurations: np.ndarray, layout: DiscLayout) -> DiscSection:
         slots, next_slots = (
             ends_of + (top - layout.frame.offset(ends_of))[:, None] * e2
             for ends_of in (columns, next_columns))
-        passed = [next_slots + (staging_slots(projections[m + 1], order, layout)
-                                - there.slots)[:, None] * e1
+        # Slots one pitch apart on the same centre: an order's lie (order - next rank) g
+        # from the next configuration's.
+        passed = [next_slots + ((order - next_rank) * layout.pitch)[:, None] * e1
                   for order in orders[:-1]] + [next_slots]
         stages += [*here.risen[1:], columns]
         names += [*here.names, GATHER]

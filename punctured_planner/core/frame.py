@@ -137,6 +137,16 @@ def _room(obstacles, bounds, e2):
         return 0.0
 
 
+def _most_room(obstacles, bounds, directions):
+    """
+    Return the index of the direction e2 with the most room (_room) among directions.
+
+    Rooms within _ROOM_TIE of the most are a tie, which the first of them wins.
+    """
+    rooms = np.array([_room(obstacles, bounds, e2) for e2 in directions])
+    return int(np.argmax(rooms >= rooms.max() * (1.0 - _ROOM_TIE)))
+
+
 def _reach(obstacles, e2):
     """
     Return how far the farthest obstacle lies along e2 from the middle of the obstacles.
@@ -205,8 +215,7 @@ def choose_frame(obstacles: np.ndarray, bounds: np.ndarray | None = None,
               if r < 2 or np.all(np.diff(np.sort(frame.project(obstacles)))
                                  > (0.0 if _is_axis(frame) else resolution))]
     if frames and r > 0 and bounds is not None:
-        rooms = np.array([_room(obstacles, bounds, frame.e2) for frame in frames])
-        return frames[int(np.argmax(rooms >= rooms.max() * (1.0 - _ROOM_TIE)))]
+        return frames[_most_room(obstacles, bounds, [frame.e2 for frame in frames])]
     if frames and r > 0 and oblique:
         # The axis frames keep the request's own coordinates (lanes along the building's
         # walls, exact projections): an oblique one must pay for itself (design section 4).
@@ -220,10 +229,8 @@ def choose_frame(obstacles: np.ndarray, bounds: np.ndarray | None = None,
     gaps = np.diff(np.sort(obstacles @ directions.T, axis=0), axis=0).min(axis=0)
     e1 = directions[int(np.argmax(gaps))]
     e2 = _complement_direction(e1)
-    # With walls, towards the more room, as every other frame is chosen.
-    if bounds is not None and (_room(obstacles, bounds, -e2)
-                               > _room(obstacles, bounds, e2) * (1.0 + _ROOM_TIE)):
-        e2 = -e2
+    if bounds is not None:  # towards the more room, as every other frame with walls
+        e2 = (e2, -e2)[_most_room(obstacles, bounds, (e2, -e2))]
     return Frame(_origin(obstacles, bounds, e1), e1, e2)
 
 
