@@ -16,6 +16,7 @@ from hypothesis import assume, example, given, HealthCheck, settings, strategies
 import numpy as np
 from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
 from punctured_planner.core.certificate import certify_bodies, RELATIVE_RESOLUTION
+from punctured_planner.core.plan import Plan
 from punctured_planner.core.refine import Bodies, refine
 from punctured_planner.core.walls import smallest_leg_slack
 import pytest
@@ -143,24 +144,15 @@ def test_required_clearance_is_judged_on_the_refined_plan():
     assert plan(met, request).min_gap >= 0.3
 
 
-def motion_at(motion, tau):
-    """Return the (T, k, d) positions of a Refinement's motion at times tau (T,)."""
-    leg = np.clip(np.searchsorted(motion.times, tau, side='right') - 1, 0,
-                  motion.times.size - 2)
-    span = motion.times[leg + 1] - motion.times[leg]
-    f = np.where(span > 0, (tau - motion.times[leg]) / np.where(span > 0, span, 1.0), 0.0)
-    f = f[:, None, None]
-    return (1.0 - f) * motion.positions[leg] + f * motion.positions[leg + 1]
-
-
 def refined_with_walls(raw, bounds):
-    """Return core.refine's motion of raw's construction with walls at bounds."""
+    """Return raw's Plan refined by core.refine with walls at bounds (None for none)."""
     workspace = raw.workspace
     k = raw.positions.shape[1]
     radii = np.concatenate([np.full(k, workspace.robot_radius), workspace.obstacle_radii])
     rounding = RELATIVE_RESOLUTION * float(np.abs(raw.positions).max(initial=1.0))
-    return refine(raw.times, raw.positions, raw.waypoint_indices,
-                  Bodies(workspace.obstacles, radii, raw.min_gap, rounding, bounds))
+    return Plan.refined(raw, refine(raw.times, raw.positions, raw.waypoint_indices,
+                                    Bodies(workspace.obstacles, radii, raw.min_gap, rounding,
+                                           bounds)))
 
 
 def wall_bounds(raw, share, seed):
@@ -234,7 +226,7 @@ def test_with_walls_a_small_change_inside_a_domain_moves_the_refined_motion_litt
 
     def change(walls):
         first, second = refined_with_walls(before, walls), refined_with_walls(after, walls)
-        return np.abs(motion_at(first, TAU) - motion_at(second, TAU)).max()
+        return np.abs(first.position(TAU) - second.position(TAU)).max()
 
     with_walls = change(bounds)
     assert with_walls <= max(CONTINUITY * NUDGE, 2.0 * change(None)), with_walls / NUDGE

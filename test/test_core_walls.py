@@ -21,7 +21,7 @@ from punctured_planner.core.validation import validate_configurations
 from punctured_planner.core.walls import (checked_bounds, first_outside, smallest_leg_slack,
                                           wall_slack)
 import pytest
-from test_core_refine import CONTINUITY, motion_at, NUDGE, nudged, refined_with_walls, TAU
+from test_core_refine import CONTINUITY, NUDGE, nudged, refined_with_walls, TAU
 
 PROPERTY = settings(max_examples=150, deadline=None,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
@@ -497,7 +497,7 @@ def passing_change(walled, configurations, seed):
     constructions = [walled_construction(walled, c) for c in (configurations, moved)]
     assume(constructions[0].leg_names.count('slide') > len(configurations) - 1)
     before, after = (refined_with_walls(c, walled.bounds) for c in constructions)
-    return np.abs(motion_at(before, TAU) - motion_at(after, TAU)).max()
+    return np.abs(before.position(TAU) - after.position(TAU)).max()
 
 
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.filter_too_much])
