@@ -269,8 +269,8 @@ def test_overlapping_bodies_are_refused_naming_the_culprits(configuration, code,
 
 
 @pytest.mark.parametrize('options, words', [
-    ({'robot_radius': -0.1}, 'robot_radius must be finite and non-negative'),
-    ({'robot_radius': np.nan}, 'robot_radius must be finite and non-negative'),
+    ({'robot_radius': -0.1}, 'robot_radius must be 0 or a real number between'),
+    ({'robot_radius': np.nan}, 'robot_radius must be 0 or a real number between'),
     ({'obstacle_radius': [0.1, -1.0]}, 'obstacle 1: obstacle_radius'),
     ({'obstacle_radius': [0.1, 0.2, 0.3]}, 'one value per obstacle'),
 ])

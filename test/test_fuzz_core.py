@@ -21,9 +21,11 @@ Guaranteed range (measured here, stated for msg_docs):
   the resolution limit the float64 rounding of the closed form dominates (seen
   up to 4e-5 relative at S = 3e11, D = 1). Since D > 1e-12 S, the true minimum
   is always at least D (1 - 1e-3) > 0.
-* Lane spacing and min_spacing >= 1e-100 (far below any node parameter); the
-  certificate rescales far-from-unit coordinates by a power of two, so even
-  lengths near 1e-160 are certified exactly (test_subnormal_scale_...).
+* Lengths (lane_spacing, min_spacing, the radii, required_clearance): 0 where
+  allowed, else between 1e-100 and 1e15 (core.limits; far beyond any node
+  parameter), else INVALID_REQUEST naming the option. The certificate rescales
+  far-from-unit coordinates by a power of two, so even a motion at 1e-160 is
+  certified exactly (test_subnormal_scale_...).
 """
 
 from fractions import Fraction
@@ -33,9 +35,9 @@ from hypothesis import strategies as st
 import hypothesis.extra.numpy as hnp
 from motion_check import assert_certificate_agrees, exact_minimum, UNIT_ROUNDOFF
 import numpy as np
-from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
-from punctured_planner.core.certificate import RELATIVE_RESOLUTION
-from punctured_planner.core.validation import MAX_COORDINATE
+from punctured_planner.core import ErrorCode, MAX_COORDINATE, plan, PlanningError, Workspace
+from punctured_planner.core.certificate import certify, RELATIVE_RESOLUTION
+from punctured_planner.core.limits import lengths_in_range
 import pytest
 
 FUZZ = settings(max_examples=1200, deadline=None,
@@ -348,7 +350,13 @@ def test_extreme_scales_are_certified_or_refused_never_a_silent_collision(case):
     except PlanningError as error:
         event('workspace refused: ' + error.code.name)
         assert error.code in (ErrorCode.INVALID_REQUEST, ErrorCode.OBSTACLES_DEGENERATE)
-        if error.code == ErrorCode.INVALID_REQUEST:
+        if error.code == ErrorCode.INVALID_REQUEST and error.obstacle is None:
+            # A length beyond the supported ones (core.limits): spacings, the clearance.
+            lengths = [options['lane_spacing'], options['min_spacing']]
+            lengths += [options['required_clearance']] if options['required_clearance'] else []
+            assert not lengths_in_range(lengths, zero=False).all(), str(error)
+            assert 'a real number between' in str(error)
+        elif error.code == ErrorCode.INVALID_REQUEST:
             assert np.abs(obstacles).max() > MAX_COORDINATE
             assert 'obstacle %d' % error.obstacle in str(error)
         else:
@@ -500,15 +508,47 @@ def test_non_numeric_requests_raise_planning_error(request_):
 
 
 @pytest.mark.parametrize('variant', ['paper', 'spread'])
-def test_subnormal_scale_certificate_is_exact_or_refused(variant):
-    """Every length scaled to 1e-160, lanes too: a correct certificate or a refusal."""
-    s = 1e-160
-    ws = Workspace(np.array([[0.0, 0.0], [1.0, 0.0]]) * s, lane_spacing=s, min_spacing=s,
-                   variant=variant)
-    configurations = np.array([[[0.3, 0.7], [0.6, -0.2]], [[0.61, 0.5], [0.2, -0.4]]]) * s
-    try:
-        p = plan(ws, configurations)
-    except PlanningError as error:
-        assert error.code == ErrorCode.CLEARANCE_BELOW_REQUIRED
-        return
-    assert_certificate_agrees(p.positions, ws.obstacles, p.min_clearance)
+def test_subnormal_scale_certificate_is_exact(variant):
+    """A plan scaled by 2^-532 (about 1e-160), lanes too, certifies to its clearance scaled."""
+    ws = Workspace([[0.0, 0.0], [1.0, 0.0]], variant=variant)
+    configurations = np.array([[[0.3, 0.7], [0.6, -0.2]], [[0.61, 0.5], [0.2, -0.4]]])
+    p = plan(ws, configurations)
+    tiny = [np.ldexp(points, -532) for points in (p.positions, ws.obstacles)]
+    clearance = certify(p.times, *tiny).distance
+    # A power of two scales every step of the closed form exactly, once rescaled.
+    assert clearance == np.ldexp(p.min_clearance, -532)
+    assert_certificate_agrees(*tiny, clearance)
+
+
+@pytest.mark.parametrize('options, words', [
+    ({'lane_spacing': 1e-160}, 'lane_spacing must be a real number between 1e-100 and 1e+15'),
+    ({'min_spacing': 1e300}, 'min_spacing must be a real number between'),
+    ({'min_spacing': None}, 'min_spacing must be a real number between 1e-100 and 1e+15, '
+                            'got None'),
+    ({'lane_spacing': '0.1'}, "got '0.1'"),
+    ({'lane_spacing': [1.0]}, 'got [1.0]'),
+    ({'required_clearance': 1e-200}, 'required_clearance must be 0 or a real number between'),
+    ({'robot_radius': 1e16}, 'robot_radius must be 0 or a real number between'),
+    ({'obstacle_radius': [0.1, 1e-120]}, 'obstacle 1: obstacle_radius must be 0 or'),
+    ({'bounds': [[-1e308, 1e308], [-1.0, 1.0]]}, 'x_min = -1e+308 is beyond the supported'),
+    ({'dimension': 2.5}, 'dimension must be an integer or None, got 2.5'),
+    ({'frame': ([0, 0], [1, 0])}, 'frame must be a Frame or (origin, e1, e2)'),
+    ({'obstacles': [[1.0, 2.0], [3.0]]}, 'the obstacle array is not an array of real numbers'),
+    ({'obstacles': [[1 + 1j, 0.0]]}, 'the obstacle array is not an array of real numbers'),
+])
+def test_options_outside_the_supported_range_are_refused_naming_them(options, words):
+    """Lengths outside [1e-100, 1e15] (or 0 where allowed) and odd types: INVALID_REQUEST."""
+    options = {'obstacles': [[0.0, 0.0], [1.0, 0.5]], **options}
+    with pytest.raises(PlanningError) as refused:
+        Workspace(options.pop('obstacles'), variant='discs', **options)
+    assert refused.value.code == ErrorCode.INVALID_REQUEST
+    assert words in str(refused.value)
+
+
+def test_the_ends_of_the_supported_lengths_are_accepted():
+    """Every length at 1e-100 or at 1e15, radii and the clearance at 0 too, is a workspace."""
+    for length in (1e-100, 1e15):
+        Workspace([[0.0, 0.0]], variant='discs', lane_spacing=length, min_spacing=length,
+                  required_clearance=length, robot_radius=length, obstacle_radius=length)
+    Workspace([[0.0, 0.0]], variant='discs', required_clearance=0, robot_radius=0,
+              obstacle_radius=np.float32(0))

@@ -8,17 +8,17 @@ plan as breakpoints), ``certificate`` (exact clearance), ``timing`` (time
 parameterisation), ``complexity`` (domains and TC_n), ``pairs`` (index arrays
 of point pairs), ``discs`` (the construction for disc robots among pillars),
 ``refine`` (the refinement of every construction's motion), ``walls`` (workspace
-bounds), ``validation`` and ``errors``.
+bounds), ``limits`` (the supported ranges), ``validation`` and ``errors``.
 The design, with the proofs, is doc/design.md.
 """
 
 from .certificate import Clearance
 from .errors import ErrorCode, PlanningError
 from .frame import Frame
+from .limits import first_out_of_range, MAX_COORDINATE
 from .plan import Plan, plan, Samples
 from .sections import Schedule, SCHEDULES, VARIANTS
 from .space import Workspace
-from .validation import first_out_of_range, MAX_COORDINATE
 
 __all__ = ['Clearance', 'ErrorCode', 'first_out_of_range', 'Frame', 'MAX_COORDINATE', 'Plan',
            'PlanningError', 'Samples', 'Schedule', 'SCHEDULES', 'VARIANTS', 'Workspace', 'plan']

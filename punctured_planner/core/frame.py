@@ -15,7 +15,7 @@ import numpy.typing as npt
 from scipy.spatial import ConvexHull, QhullError
 
 from .certificate import RELATIVE_RESOLUTION
-from .errors import ErrorCode, PlanningError
+from .errors import ErrorCode, literal, PlanningError
 from .walls import box_corners
 
 _ORTHONORMAL_TOLERANCE = 1e-9
@@ -238,7 +238,13 @@ def checked_frame(frame: Frame | tuple, dimension: int) -> Frame:
     """Return a Frame or (origin, e1, e2) as a Frame, dimension and orthonormality checked."""
     if isinstance(frame, Frame):
         frame = (frame.origin, frame.e1, frame.e2)
-    origin, e1, e2 = (np.asarray(v, dtype=float).reshape(-1) for v in frame)
+    try:
+        origin, e1, e2 = (np.asarray(v, dtype=float).reshape(-1) for v in frame)
+    except (TypeError, ValueError):
+        raise PlanningError(ErrorCode.INVALID_REQUEST,
+                            f'frame must be a Frame or (origin, e1, e2), three '
+                            f'{dimension}-vectors of real numbers; got {literal(repr(frame))}'
+                            ) from None
     if not (origin.size == e1.size == e2.size == dimension):
         raise PlanningError(ErrorCode.INVALID_REQUEST,
                             f'frame vectors must have dimension {dimension}')

@@ -5,6 +5,7 @@ The lanes lie beyond every obstacle's e2 offset (doc/design.md section 4).
 """
 
 from functools import cached_property
+import numbers
 
 import numpy as np
 import numpy.typing as npt
@@ -12,8 +13,10 @@ import numpy.typing as npt
 from .discs import DiscLayout
 from .errors import ErrorCode, literal, PlanningError
 from .frame import checked_frame, choose_frame, Frame
+from .limits import checked_length, first_out_of_range, length_range, lengths_in_range
+from .limits import MAX_COORDINATE
 from .sections import VARIANTS
-from .validation import first_out_of_range, MAX_COORDINATE
+from .validation import real_array
 from .walls import checked_bounds, first_outside
 
 
@@ -55,7 +58,12 @@ class Workspace:
                  obstacle_radius: npt.ArrayLike = 0.0,
                  bounds: npt.ArrayLike | None = None) -> None:
         """Validate the obstacles and options and fix the frame."""
-        obstacles = np.asarray(obstacles, dtype=float)
+        if dimension is not None and (isinstance(dimension, bool)
+                                      or not isinstance(dimension, numbers.Integral)):
+            raise PlanningError(ErrorCode.INVALID_REQUEST,
+                                f'dimension must be an integer or None, got '
+                                f'{literal(repr(dimension))}')
+        obstacles = real_array(obstacles, 'the obstacle array')
         if obstacles.size == 0:
             if obstacles.ndim == 2 and obstacles.shape[1] > 0:
                 dimension = obstacles.shape[1] if dimension is None else dimension
@@ -63,6 +71,9 @@ class Workspace:
                 raise PlanningError(ErrorCode.INVALID_REQUEST,
                                     f'obstacles of shape {obstacles.shape} do not give the '
                                     f'dimension d: pass dimension=d or a (0, d) array')
+            if dimension < 2:
+                raise PlanningError(ErrorCode.INVALID_REQUEST,
+                                    'the dimension d must be at least 2')
             obstacles = obstacles.reshape(0, dimension)
         if obstacles.ndim != 2 or (dimension is not None and obstacles.shape[1] != dimension):
             raise PlanningError(ErrorCode.INVALID_REQUEST,
@@ -80,13 +91,14 @@ class Workspace:
             raise PlanningError(ErrorCode.INVALID_REQUEST,
                                 f'{{obstacle}} is beyond the supported range '
                                 f'+-{MAX_COORDINATE:.0e}', obstacle=far[0], coordinate=far[1])
-        self._check_options(variant, lane_spacing, min_spacing, required_clearance)
+        self._check_variant(variant)
+        self.lane_spacing = checked_length(lane_spacing, 'lane_spacing', zero=False)
+        self.min_spacing = checked_length(min_spacing, 'min_spacing', zero=False)
+        self.required_clearance = checked_length(required_clearance, 'required_clearance',
+                                                 zero=True)
         self.bounds = checked_bounds(bounds, self.dimension)
         self.obstacles = obstacles
         self.variant = variant
-        self.lane_spacing = float(lane_spacing)
-        self.min_spacing = float(min_spacing)
-        self.required_clearance = float(required_clearance)
         self.robot_radius, self.obstacle_radii = _checked_radii(robot_radius, obstacle_radius,
                                                                 len(obstacles))
         self._reject_coincident_obstacles()
@@ -135,18 +147,11 @@ class Workspace:
                                 wall=outside.wall, distance=outside.beyond)
 
     @staticmethod
-    def _check_options(variant, lane_spacing, min_spacing, required_clearance):
-        """Raise INVALID_REQUEST for an unknown variant or a non-positive spacing."""
+    def _check_variant(variant):
+        """Raise INVALID_REQUEST for an unknown variant."""
         if variant not in VARIANTS:
             raise PlanningError(ErrorCode.INVALID_REQUEST,
                                 f'variant must be one of {VARIANTS}, got {literal(repr(variant))}')
-        if not (np.isfinite(lane_spacing) and lane_spacing > 0):
-            raise PlanningError(ErrorCode.INVALID_REQUEST, 'lane_spacing must be positive')
-        if not (np.isfinite(min_spacing) and min_spacing > 0):
-            raise PlanningError(ErrorCode.INVALID_REQUEST, 'min_spacing must be positive')
-        if not (np.isfinite(required_clearance) and required_clearance >= 0):
-            raise PlanningError(ErrorCode.INVALID_REQUEST,
-                                'required_clearance must be non-negative')
 
     @property
     def obstacle_count(self) -> int:
@@ -175,25 +180,19 @@ class Workspace:
 
 
 def _checked_radii(robot_radius, obstacle_radius, obstacle_count):
-    """Return (R, rho (r,)) after checking they are finite, non-negative and rho has r values."""
-    try:
-        radius = float(robot_radius)
-        radii = np.asarray(obstacle_radius, dtype=float)
-    except (TypeError, ValueError):
-        raise PlanningError(ErrorCode.INVALID_REQUEST,
-                            'robot_radius and obstacle_radius must be real numbers') from None
-    if not (np.isfinite(radius) and radius >= 0):
-        raise PlanningError(ErrorCode.INVALID_REQUEST,
-                            f'robot_radius must be finite and non-negative, got {radius}')
+    """Return (R, rho (r,)) after checking they are lengths (limits) and rho has r values."""
+    radius = checked_length(robot_radius, 'robot_radius', zero=True)
+    radii = real_array(obstacle_radius, 'obstacle_radius')
     if radii.ndim == 0:
         radii = np.full(obstacle_count, float(radii))
     if radii.shape != (obstacle_count,):
         raise PlanningError(ErrorCode.INVALID_REQUEST,
                             f'obstacle_radius must be a scalar or one value per obstacle '
                             f'(shape ({obstacle_count},)), got shape {radii.shape}')
-    bad = np.flatnonzero(~(np.isfinite(radii) & (radii >= 0)))
+    bad = np.flatnonzero(~lengths_in_range(radii, zero=True))
     if bad.size:
         raise PlanningError(ErrorCode.INVALID_REQUEST,
-                            '{obstacle}: obstacle_radius must be finite and '
-                            f'non-negative, got {radii[bad[0]]}', obstacle=int(bad[0]))
+                            '{obstacle}: obstacle_radius must be '
+                            f'{length_range(zero=True)}, got {radii[bad[0]]}',
+                            obstacle=int(bad[0]))
     return radius, radii

@@ -14,43 +14,29 @@ import numpy.typing as npt
 from scipy.spatial import cKDTree
 
 from .errors import ErrorCode, literal, PlanningError
+from .limits import first_out_of_range, MAX_COORDINATE
 from .pairs import pair_difference_matrix, point_pairs, with_obstacles
 from .walls import first_outside
 
-# Coordinates beyond this magnitude are refused: squared distances must not
-# overflow, and the certificate's resolution (1e-12 of the scale) stays useful.
-MAX_COORDINATE = 1e15
 # Up to this many robots, coincidences are found by comparing every pair.
 _PAIRWISE_ROBOTS = 32
 
 
-def _real_array(item, configuration=None):
-    """Return item as a float array, or raise INVALID_REQUEST if it is not real numbers."""
+def real_array(item: object, what: str, configuration: int | None = None) -> np.ndarray:
+    """
+    Return item as a float array, or raise INVALID_REQUEST if it is not real numbers.
+
+    what names it in the message ('{configuration}' with configuration m).
+    """
     try:
         array = np.asarray(item)
         if array.dtype.kind not in 'biuf':
             raise TypeError(f'elements of type {array.dtype}')
         return array.astype(float)
     except (TypeError, ValueError, OverflowError) as error:
-        what = 'the request' if configuration is None else '{configuration}'
         raise PlanningError(ErrorCode.INVALID_REQUEST,
                             f'{what} is not an array of real numbers: {literal(error)}',
                             configuration=configuration) from None
-
-
-def first_out_of_range(values: np.ndarray) -> tuple[int, ...] | None:
-    """
-    Return the index of the first finite coordinate beyond +-MAX_COORDINATE, or None.
-
-    The one range rule of the package: every layer finds its offender here and
-    words its own message. Non-finite values are not out of range (they have
-    their own code, NON_FINITE_VALUE).
-    """
-    values = np.asarray(values)
-    if (np.abs(values) <= MAX_COORDINATE).all():
-        return None
-    far = np.argwhere(np.isfinite(values) & (np.abs(values) > MAX_COORDINATE))
-    return tuple(int(i) for i in far[0]) if far.size else None
 
 
 def _reject_out_of_range(configurations, first=0):
@@ -81,7 +67,7 @@ def _as_array(configurations, dimension):
     robot counts are compared (ROBOT_COUNT_MISMATCH): the smaller code wins.
     """
     if isinstance(configurations, np.ndarray) and configurations.ndim == 3:
-        configurations = _real_array(configurations)
+        configurations = real_array(configurations, 'the request')
         if configurations.shape[0] < 2:
             raise PlanningError(ErrorCode.NO_CONFIGURATIONS,
                                 f'need at least 2 configurations, got {configurations.shape[0]}')
@@ -95,7 +81,7 @@ def _as_array(configurations, dimension):
     if len(items) < 2:
         raise PlanningError(ErrorCode.NO_CONFIGURATIONS,
                             f'need at least 2 configurations, got {len(items)}')
-    arrays = [_real_array(item, m) for m, item in enumerate(items)]
+    arrays = [real_array(item, '{configuration}', m) for m, item in enumerate(items)]
     for m, array in enumerate(arrays):
         if array.ndim != 2 or array.shape[1] != dimension:
             raise PlanningError(ErrorCode.INVALID_REQUEST,

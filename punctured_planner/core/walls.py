@@ -18,6 +18,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .errors import axis_name, ErrorCode, PlanningError, Wall
+from .limits import first_out_of_range, MAX_COORDINATE
 
 
 @dataclass(frozen=True)
@@ -59,8 +60,9 @@ def checked_bounds(bounds: npt.ArrayLike | None, dimension: int) -> np.ndarray |
     Return bounds as a float (d, 2) array of [low, high] per axis, or None for none.
 
     Raises INVALID_REQUEST, saying which shape was expected and which arrived,
-    for a non-finite value, or for a low not below its high (the wall at fault
-    as ``wall``: the non-finite one, or the low).
+    for a non-finite value, a value beyond the supported range (core.limits), or
+    for a low not below its high (the wall at fault as ``wall``: the non-finite
+    one, the one out of range, or the low).
     """
     if bounds is None:
         return None
@@ -79,6 +81,11 @@ def checked_bounds(bounds: npt.ArrayLike | None, dimension: int) -> np.ndarray |
         raise PlanningError(ErrorCode.INVALID_REQUEST,
                             f'bounds must be finite; {{wall}} is {array[tuple(bad[0])]}',
                             wall=wall)
+    far = first_out_of_range(array)
+    if far is not None:
+        raise PlanningError(ErrorCode.INVALID_REQUEST,
+                            f'bounds: {{wall}} = {array[far]:.6g} is beyond the supported range '
+                            f'+-{MAX_COORDINATE:.0e}', wall=Wall(far[0], bool(far[1])))
     empty = np.flatnonzero(~(array[:, 0] < array[:, 1]))
     if empty.size:
         axis = int(empty[0])
