@@ -215,12 +215,13 @@ def test_every_error_code_and_the_node_keeps_serving(planner, ros_client, monkey
     node.set_parameters(robot_count=0)
     valid()
 
-    assert all(r.successful
-               for r in node.set_parameters(obstacles=flat(OBSTACLES + OBSTACLES[:1])))
-    expect(make_request(), codes.OBSTACLES_DEGENERATE,
-           'obstacle 0 at (-2, 0.5, 0) (from the parameter) and obstacle 3 at (-2, 0.5, 0) '
-           '(from the parameter) are at the same point')
-    node.set_parameters(obstacles=flat(OBSTACLES))
+    # A set the node cannot plan in is refused where it arrives, the parameter on set.
+    degenerate = node.set_parameters(obstacles=flat(OBSTACLES + OBSTACLES[:1]))[0]
+    assert not degenerate.successful
+    assert ('OBSTACLES_DEGENERATE with 4 obstacles from the parameter' in degenerate.reason
+            and 'obstacle 0 at (-2, 0.5, 0) (from the parameter) and obstacle 3 at (-2, 0.5, '
+            '0) (from the parameter) are at the same point' in degenerate.reason), \
+        degenerate.reason
     valid()
 
     node.set_parameters(required_clearance=50.0)
@@ -237,11 +238,10 @@ def test_every_error_code_and_the_node_keeps_serving(planner, ros_client, monkey
            '(centre x = 4.25)')
     expect(make_request([c1, moved(c2, 3, [4.25, 1.0, 0.0]), moved(c3, 0, OBSTACLES[1])]),
            codes.ROBOT_ON_OBSTACLE, 'configuration 2', 'robot 0')  # it ranks before
-    node.set_parameters(obstacles=flat(OBSTACLES[:2] + [[2.5, -3.5, 0.0]]))
-    expect(make_request(), codes.OUTSIDE_WORKSPACE,
-           'obstacle 2 at (2.5, -3.5, 0) (from the parameter) is 0.5 beyond the wall y_min '
-           '(workspace_bounds[2]) = -3')
-    node.set_parameters(obstacles=flat(OBSTACLES))
+    outside = node.set_parameters(obstacles=flat(OBSTACLES[:2] + [[2.5, -3.5, 0.0]]))[0]
+    assert not outside.successful
+    assert ('obstacle 2 at (2.5, -3.5, 0) (from the parameter) is 0.5 beyond the wall y_min '
+            '(workspace_bounds[2]) = -3' in outside.reason), outside.reason
     from punctured_planner.core import plan, PlanningError, Workspace
     with pytest.raises(PlanningError) as leaves:  # the construction's lanes leave the box
         plan(Workspace(np.array(OBSTACLES)[:, :2], variant='spread',
@@ -267,7 +267,8 @@ def test_every_error_code_and_the_node_keeps_serving(planner, ros_client, monkey
     valid()
 
     documented = {v for k, v in vars(codes).items() if k.isupper() and isinstance(v, int)}
-    assert seen == documented - {codes.NONE}
+    # OBSTACLES_DEGENERATE is the core's: the node refuses such a set where it arrives.
+    assert seen == documented - {codes.NONE, codes.OBSTACLES_DEGENERATE}
 
 
 def test_parameter_changes_take_effect_and_bad_values_are_refused(planner, ros_client):
@@ -381,6 +382,49 @@ def test_parameters_over_the_parameter_service(planner, ros_client):
     described = result(remote.describe_parameters(['workspace_bounds'])).descriptors[0]
     assert 'OUTSIDE_WORKSPACE' in described.description
     assert described.additional_constraints
+
+
+def test_settings_the_obstacles_parameter_cannot_take_are_refused(planner, ros_client):
+    """
+    Radii, walls or obstacles the parameter's set cannot be planned with: refused on set.
+
+    The old values stay and the node plans on; no parameter can be deleted (rclpy
+    would undeclare it, and every later change would fail on it).
+    """
+    from rclpy.parameter_client import AsyncParameterClient
+    plan_sequence = _types()[0]
+    node = planner(obstacles=flat(OBSTACLES), variant='discs', robot_radius=0.2)
+    client = service_client(ros_client, node)
+    refused = {
+        'obstacle_radius': ([0.1, 0.2], 'obstacle_radius must be a scalar or one value per '
+                            'obstacle (shape (3,)), got shape (2,); to change obstacles and '
+                            'obstacle_radius together'),
+        'workspace_bounds': ([-1.0, 5.0, -5.0, 5.0], 'obstacle 0 at (-2, 0.5, 0) (from the '
+                             'parameter) is 1 beyond the wall x_min'),
+        'obstacles': ([0.0, 0.0, 0.0, 0.0, 0.0, 0.0], 'OBSTACLES_DEGENERATE with 2 obstacles '
+                      'from the parameter'),
+    }
+    for name, (value, words) in refused.items():
+        before = node.node.get_parameter(name).value
+        results = node.set_parameters(**{name: value})
+        assert not results[0].successful, (name, value)
+        assert words in results[0].reason, results[0].reason
+        assert node.node.get_parameter(name).value == before, name
+    off_plane = node.set_parameters(obstacles=[0.0, 0.0, 5.0])[0]
+    assert not off_plane.successful and 'OFF_PLANE' in off_plane.reason, off_plane.reason
+
+    remote = AsyncParameterClient(ros_client.node, node.name('planner_node'))
+    assert remote.wait_for_services(timeout_sec=20)
+    deleted = remote.delete_parameters(['workspace_bounds', 'obstacle_radius'])
+    assert ros_client.spin_until(deleted.done, 20)
+    assert not any(result.successful for result in deleted.result().results)
+    assert 'cannot be deleted' in deleted.result().results[0].reason
+    # Every parameter is still there, and changes still take.
+    assert all(r.successful for r in node.set_parameters(max_speed=0.5,
+                                                         workspace_bounds=[-5.0, 5.0, -5.0,
+                                                                           5.0]))
+    response = ros_client.call(client, make_request())
+    assert response.error_code == plan_sequence.Response.NONE, response.error_msg
 
 
 def test_odometry_assembles_the_current_state(planner, ros_client):

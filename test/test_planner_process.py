@@ -69,8 +69,11 @@ def test_default_scenario_across_processes(planner_process, ros_client, ros_env)
     assert node.stop() == 0, node.log()
 
 
-@pytest.mark.parametrize('arguments', [('-p', 'dimension:=5'), ('-p', 'variant:=fast')],
-                         ids=['out-of-range', 'refused-by-validation'])
+@pytest.mark.parametrize('arguments', [
+    ('-p', 'dimension:=5'), ('-p', 'variant:=fast'),
+    ('-p', 'obstacles:=[0.5, 0.5, 0.0, 3.0, 0.5, 0.0]',
+     '-p', 'workspace_bounds:=[0.0, 1.0, 0.0, 1.0]'),
+], ids=['out-of-range', 'refused-by-validation', 'obstacles-beyond-the-walls'])
 def test_invalid_parameters_stop_the_node(planner_process, arguments):
     """A bad parameter at start-up: exit code 2 and the reason, not a traceback."""
     node = planner_process(*arguments)

@@ -56,7 +56,7 @@ def checked_length(value: object, name: str, zero: bool) -> float:
     A real number (Python's or numpy's) between MIN_LENGTH and MAX_COORDINATE,
     or with zero 0; anything else (a string, None, a list, NaN) is refused.
     """
-    if isinstance(value, numbers.Real) and lengths_in_range(float(value), zero):
+    if isinstance(value, numbers.Real) and lengths_in_range(np.array(float(value)), zero):
         return float(value)
     raise PlanningError(ErrorCode.INVALID_REQUEST,
                         f'{name} must be {length_range(zero)}, got '

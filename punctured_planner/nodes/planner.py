@@ -108,9 +108,11 @@ class PlannerNode(Node):
         self._robot_states: RobotState | None = None
         self._odometry: dict[str, RobotOdometry] = {}
         self._obstacles: ObstacleSet  # from the parameters, two lines below
-        self._node_parameters = NodeParameters(self, PLANNER, self._apply_parameters)
+        self._node_parameters = NodeParameters(self, PLANNER, self._apply_parameters,
+                                               self._check_obstacles_fit)
         self._settings: PlannerSettings = self._node_parameters.settings
         self._obstacles = self._parameter_obstacles(self._settings)
+        self._check_obstacles_fit(self._settings, {'obstacles'})
 
         # The subscriptions' and the publishers' own nodes: spun apart from the
         # service (module docstring).
@@ -164,9 +166,35 @@ class PlannerNode(Node):
         if 'robot_names' in changed:
             self._update_odometry_subscriptions(settings.robot_names)
 
+    def _check_obstacles_fit(self, settings: PlannerSettings, changed: set[str]) -> None:
+        """
+        On-set and at start-up: refuse settings the parameter's obstacles cannot be planned in.
+
+        A new obstacles value gets the checks a set arriving on the topic gets
+        (PlanSequenceHandler.check_obstacles); a set in use from the parameter, when
+        other settings change, the core's Workspace rule (check_workspace: its
+        obstacle_radius count, obstacles beyond workspace_bounds). So plane_z or
+        frame_id may change first and the obstacles follow. A set from the topic is
+        checked when it arrives, and an empty set is not checked: per-obstacle radii
+        may wait for the topic's set.
+        """
+        new = 'obstacles' in changed
+        obstacles = self._parameter_obstacles(settings) if new else self._obstacles
+        if not (obstacles.from_parameter and len(obstacles.points)):
+            return
+        try:
+            (self._handler.check_obstacles if new
+             else self._handler.check_workspace)(settings, obstacles)
+        except PlanningError as error:
+            hint = ('; to change obstacles and obstacle_radius together, set both in one call '
+                    '(ros2 param load) or make obstacle_radius one value first'
+                    if changed & {'obstacles', 'obstacle_radius'} else '')
+            raise ValueError('%s with %s: %s%s' % (
+                error.code.name, obstacles.describe(),
+                error.describe(ObstacleNames(obstacles)), hint)) from None
+
     def _parameter_obstacles(self, settings: PlannerSettings) -> ObstacleSet:
         return ObstacleSet(conversions.obstacles_from_parameter(settings.obstacles),
-                           frame_id='', source='parameter',
                            stamp_ns=self.get_clock().now().nanoseconds)
 
     # ------------------------------------------------------------ subscriptions

@@ -266,15 +266,21 @@ class NodeParameters(Generic[S]):
     :attr:`settings` is always the node's accepted settings; ``apply(settings,
     changed names)``, when given, takes them further into the node;
     it runs in the post-set callback, so a change it cannot take is logged,
-    never raised into the parameter service.
+    never raised into the parameter service. ``check(settings, changed
+    names)``, when given, is what the node adds to the table's checks (its own
+    state against the new settings): a ValueError refuses the change in on-set.
+    A parameter is never deleted: rclpy would undeclare it, and every later
+    change would fail on it.
     """
 
     def __init__(self, node: Any, table: Table[S],
-                 apply: Callable[[S, set[str]], None] | None = None) -> None:
+                 apply: Callable[[S, set[str]], None] | None = None,
+                 check: Callable[[S, set[str]], None] | None = None) -> None:
         """Declare every parameter; raise ValueError for invalid start values."""
         self._node = node
         self._table = table
         self._apply = apply
+        self._check = check
         for spec in table.specs:
             node.declare_parameter(spec.name, spec.default, spec.descriptor())
         self.settings: S = table.settings(self.values())
@@ -288,9 +294,17 @@ class NodeParameters(Generic[S]):
         return values
 
     def _on_set(self, parameters: list) -> SetParametersResult:
-        """Refuse a change that makes the settings invalid, with the reason."""
+        """Refuse a deletion, or a change that makes the settings invalid, with the reason."""
+        deleted = [p.name for p in parameters if p.name in self._table.by_name
+                   and p.type_.value == ParameterType.PARAMETER_NOT_SET]
+        if deleted:
+            return SetParametersResult(successful=False, reason=(
+                '%s cannot be deleted: set a value instead (an empty list [] where none is '
+                'allowed)' % ', '.join(deleted)))
         try:
-            self._table.settings(self.values(parameters))
+            settings = self._table.settings(self.values(parameters))
+            if self._check is not None:
+                self._check(settings, {p.name for p in parameters})
         except ValueError as error:
             return SetParametersResult(successful=False, reason=str(error))
         return SetParametersResult(successful=True)

@@ -112,6 +112,16 @@ class PlanSequenceHandler:
         checks.check_obstacle_frame(settings, obstacles)
         checks.check_obstacle_plane(settings, obstacles)
         checks.check_obstacle_range(settings, obstacles)
+        self.check_workspace(settings, obstacles)
+
+    def check_workspace(self, settings: PlannerSettings, obstacles: ObstacleSet) -> None:
+        """
+        Raise PlanningError if the core refuses a workspace of these obstacles and settings.
+
+        The core's Workspace rule alone (obstacle_radius per obstacle, coincident
+        obstacles, obstacles beyond workspace_bounds), for a set already checked
+        as it arrived (check_obstacles) whose settings change.
+        """
         self.workspace(settings, conversions.leading_coordinates(obstacles.points,
                                                                  settings.dimension))
 

@@ -26,23 +26,32 @@ def format_stamp(ns: int) -> str:
     return '%d.%09d' % (seconds, nanoseconds)
 
 
+# ObstacleSet.source of the obstacles parameter's set (else the topic's name).
+PARAMETER = 'parameter'
+
+
 @dataclass(frozen=True, eq=False)
 class ObstacleSet:
     """The obstacles of a snapshot: (r, 3) points, their frame and where they came from."""
 
     points: np.ndarray
     frame_id: str = ''
-    source: str = 'parameter'
+    source: str = PARAMETER
     stamp_ns: int = 0
+
+    @property
+    def from_parameter(self) -> bool:
+        """Return whether the set is the obstacles parameter's (else a topic's)."""
+        return self.source == PARAMETER
 
     @property
     def origin(self) -> str:
         """Return where the set came from, as messages say it: 'the parameter', 'topic /x'."""
-        return 'the parameter' if self.source == 'parameter' else 'topic ' + self.source
+        return 'the parameter' if self.from_parameter else 'topic ' + self.source
 
     def describe(self) -> str:
         """Return a short text for the log: count, source and stamp."""
-        if self.source == 'parameter':
+        if self.from_parameter:
             return '%d obstacles from the parameter (set at %s)' % (
                 len(self.points), format_stamp(self.stamp_ns))
         return '%d obstacles from topic %s (stamp %s)' % (
