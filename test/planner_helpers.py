@@ -77,7 +77,8 @@ class InProcessPlanner:
         group = planner_nodes(context=self.context, namespace=self.namespace,
                               parameter_overrides=overrides)
         self.node = group.nodes[0]
-        self.threads = ExecutorThreads(group.nodes, context=self.context)
+        self.threads = ExecutorThreads(group.nodes, context=self.context,
+                                       refusals=group.refusals)
         self.threads.start()
 
     def name(self, relative):

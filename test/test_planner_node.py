@@ -267,8 +267,9 @@ def test_every_error_code_and_the_node_keeps_serving(planner, ros_client, monkey
     valid()
 
     documented = {v for k, v in vars(codes).items() if k.isupper() and isinstance(v, int)}
-    # OBSTACLES_DEGENERATE is the core's: the node refuses such a set where it arrives.
-    assert seen == documented - {codes.NONE, codes.OBSTACLES_DEGENERATE}
+    # OBSTACLES_DEGENERATE is the core's: the node refuses such a set where it arrives;
+    # NODE_STOPPING comes only with a stop (test_requests_waiting_past_the_stop_budget_...).
+    assert seen == documented - {codes.NONE, codes.OBSTACLES_DEGENERATE, codes.NODE_STOPPING}
 
 
 def test_parameter_changes_take_effect_and_bad_values_are_refused(planner, ros_client):
@@ -425,6 +426,47 @@ def test_settings_the_obstacles_parameter_cannot_take_are_refused(planner, ros_c
                                                                            5.0]))
     response = ros_client.call(client, make_request())
     assert response.error_code == plan_sequence.Response.NONE, response.error_msg
+
+
+def test_requests_waiting_past_the_stop_budget_are_answered_node_stopping(
+        ros_client, monkeypatch):
+    """
+    A stop answers every request that reached the node: planned, or NODE_STOPPING at once.
+
+    The budget (STOP_PLANNING_SEC) set to 0: the request in flight is planned, the two
+    that wait behind it get NODE_STOPPING, and the stop ends cleanly (doc/design.md
+    section 16). Before, every waiting request was planned, and five large ones made
+    the stop overrun its timeout, exit 1 and lose three replies.
+    """
+    import threading
+
+    import punctured_planner.core as core
+    import punctured_planner.ros.runtime as runtime
+    plan_sequence = _types()[0]
+    monkeypatch.setattr(runtime, 'STOP_PLANNING_SEC', 0.0)
+    taken = threading.Event()
+    real_plan = core.plan
+
+    def slow_plan(*args, **kwargs):
+        taken.set()
+        time.sleep(1.5)  # in flight while the stop begins
+        return real_plan(*args, **kwargs)
+
+    monkeypatch.setattr(core, 'plan', slow_plan)
+    node = InProcessPlanner(obstacles=flat(OBSTACLES))
+    client = service_client(ros_client, node)
+    futures = [client.call_async(make_request()) for _ in range(3)]
+    assert ros_client.spin_until(taken.is_set, 20)
+    closing = threading.Thread(target=node.close)
+    closing.start()
+    assert ros_client.spin_until(lambda: all(f.done() for f in futures), 30)
+    closing.join(30)
+    assert not closing.is_alive()
+    codes = sorted(f.result().error_code for f in futures)
+    assert codes == [plan_sequence.Response.NONE] + 2 * [plan_sequence.Response.NODE_STOPPING]
+    refused = [f.result() for f in futures if f.result().error_code]
+    assert all('stopping' in r.error_msg and 'send it again' in r.error_msg for r in refused)
+    assert all(len(r.paths) == 0 for r in refused)
 
 
 def test_odometry_assembles_the_current_state(planner, ros_client):

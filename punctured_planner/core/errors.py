@@ -33,6 +33,8 @@ class ErrorCode(enum.IntEnum):
     check, right after OBSTACLES_DEGENERATE; a robot outside right after
     ROBOT_ON_OBSTACLE), before any plan exists to fall below the required
     clearance; a plan that leaves the bounds right after CLEARANCE_BELOW_REQUIRED.
+    NODE_STOPPING is the node's, about no request's content: a request that
+    waited past the stop's planning budget (doc/design.md section 16).
     """
 
     NONE = 0
@@ -49,6 +51,7 @@ class ErrorCode(enum.IntEnum):
     ROBOT_ON_OBSTACLE = 11
     CLEARANCE_BELOW_REQUIRED = 12
     OUTSIDE_WORKSPACE = 13
+    NODE_STOPPING = 14
     UNKNOWN = 99
 
 

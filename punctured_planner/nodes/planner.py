@@ -60,6 +60,7 @@ from rclpy.subscription import Subscription
 from std_msgs.msg import UInt32
 from visualization_msgs.msg import MarkerArray
 
+from ..core import ErrorCode
 from ..core import PlanningError
 from ..ros import conversions
 from ..ros import publications
@@ -70,6 +71,7 @@ from ..ros.qos import SERVER_QOS
 from ..ros.qos import STATE
 from ..ros.runtime import NodeGroup
 from ..ros.runtime import run_nodes
+from ..ros.runtime import STOP_PLANNING_SEC
 from ..ros.settings import PLANNER
 from ..ros.settings import PlannerSettings
 from ..ros.snapshot import ObstacleSet
@@ -265,6 +267,29 @@ class PlannerNode(Node):
             self._resume_collection()
             raise
 
+    @property
+    def plan_service_name(self) -> str:
+        """Return the plan_sequence service's resolved name."""
+        return self._service.srv_name
+
+    def refuse_waiting(self, request: PlanSequence.Request,
+                       response: PlanSequence.Response) -> PlanSequence.Response:
+        """
+        Answer a request that waited too long into the stop, unplanned (NodeGroup.refusals).
+
+        A request taken STOP_PLANNING_SEC after the stop signal gets NODE_STOPPING
+        at once, so that the stop still answers every caller within its timeout.
+        """
+        self._request_count += 1
+        self._answering = self._request_count
+        message = ('%s stopping: request #%d (%d configurations) reached it before the '
+                   'stop signal but waited more than %.0f s into the stop, so it was not '
+                   'planned; send it again to a running node'
+                   % (self.get_name(), self._answering, len(request.configurations),
+                      STOP_PLANNING_SEC))
+        self.get_logger().warning('plan_sequence #%d: %s' % (self._answering, message))
+        return conversions.fill_error(response, ErrorCode.NODE_STOPPING, message)
+
     def _resume_collection(self) -> None:
         """Turn the cyclic collector back on if it was on when the call was taken."""
         if self._collecting:
@@ -410,7 +435,8 @@ class PlannerNode(Node):
 def planner_nodes(context: Context | None = None, **kwargs: Any) -> NodeGroup:
     """Return the PlannerNode, its inputs and its outputs node: each spun in its own thread."""
     node = PlannerNode(context=context, **kwargs)
-    return NodeGroup([node, node.inputs, node.outputs])
+    return NodeGroup([node, node.inputs, node.outputs],
+                     refusals={node.plan_service_name: node.refuse_waiting})
 
 
 def main(args: list[str] | None = None) -> int:

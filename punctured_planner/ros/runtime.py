@@ -72,6 +72,7 @@ thread still uses.
 """
 
 from dataclasses import dataclass
+from dataclasses import field
 import os
 import signal
 import sys
@@ -82,6 +83,7 @@ from typing import Any
 from typing import Callable
 from typing import Dict
 from typing import List
+from typing import Mapping
 from typing import Optional
 from typing import Sequence
 
@@ -105,6 +107,11 @@ from .qos import SERVER_QOS
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 # Seconds a callback in flight may take to finish after the stop signal.
 STOP_TIMEOUT_SEC = 30.0
+# Seconds after the stop signal within which a request that waits is still planned; a
+# later one gets the group's quick refusal (NodeGroup.refuse_waiting). A request within
+# max_poses (2,000,000 poses) took 18 s: five such waiting made the stop overrun
+# STOP_TIMEOUT_SEC, exit 1 and lose three replies (doc/design.md section 16).
+STOP_PLANNING_SEC = 10.0
 # Seconds the participant stays after the last reply it wrote (step 3 of the stop),
 # unless no client of the services that replied is left: a reliable Fast DDS writer
 # resends what a reader missed at its periodic heartbeat, every 3 s by default, and a
@@ -197,11 +204,16 @@ class NodeGroup:
     returns a Future (or None) that the thread spins on for, such as a goal's
     result going out. ``before_teardown`` runs once the executors stopped and
     before any node is destroyed: publishers still work, no callback runs any more.
+    ``refusals`` maps a service's name to ``refuse(request, response)``, which
+    fills the reply of a request that waits past STOP_PLANNING_SEC into the
+    stop: a quick answer instead of the service's own work (other services,
+    such as the parameter services, run their callback).
     """
 
     nodes: Sequence[Node]
     before_stop: Optional[Callable[[], Optional[Future]]] = None
     before_teardown: Optional[Callable[[], None]] = None
+    refusals: Mapping[str, Callable[[Any, Any], Any]] = field(default_factory=dict)
 
 
 class ExecutorThreads:
@@ -216,13 +228,16 @@ class ExecutorThreads:
 
     def __init__(self, nodes: Sequence[Node], context: Optional[Context] = None,
                  on_failure: Optional[Callable[[], None]] = None,
-                 before_stop: Optional[Callable[[], Optional[Future]]] = None):
+                 before_stop: Optional[Callable[[], Optional[Future]]] = None,
+                 refusals: Optional[Mapping[str, Callable[[Any, Any], Any]]] = None):
         """Make one executor per node (in ``context``); nothing spins yet."""
         self.nodes: List[Node] = list(nodes)
         self.failure: Optional[BaseException] = None
         self._on_failure = on_failure
         self._before_stop = before_stop
+        self._refusals = dict(refusals or {})
         self._stopping = threading.Event()
+        self._stop_began = 0.0  # time.monotonic() of the stop signal
         self._last_reply: Optional[float] = None  # time.monotonic() after the last reply
         # Who the linger waits for: the services that replied (name -> their node), and
         # whether an action server replied (its clients are not counted: it waits the
@@ -291,7 +306,10 @@ class ExecutorThreads:
 
         A request the executor had not taken yet when the signal came is in flight
         for its client too: it is taken and answered here, in this thread, as the
-        executor would (at most the server's queue depth per service).
+        executor would (at most the server's queue depth per service); from
+        STOP_PLANNING_SEC after the signal on, with the service's quick refusal
+        where the group has one (NodeGroup.refusals), so that many large requests
+        cannot hold the stop past STOP_TIMEOUT_SEC and every one is answered.
         """
         for service in node.services:
             srv_type: Any = service.srv_type  # a generated type: Request, Response
@@ -300,7 +318,13 @@ class ExecutorThreads:
                     request, header = service.handle.service_take_request(srv_type.Request)
                 if header is None:
                     break
-                service.send_response(service.callback(request, srv_type.Response()), header)
+                response = srv_type.Response()
+                refuse = self._refusals.get(service.srv_name)
+                if refuse is not None and time.monotonic() - self._stop_began > STOP_PLANNING_SEC:
+                    response = refuse(request, response)
+                else:
+                    response = service.callback(request, response)
+                service.send_response(response, header)
                 self._replied_by(service, node)
 
     def _drain(self, node: Node, executor: SingleThreadedExecutor,
@@ -334,6 +358,8 @@ class ExecutorThreads:
         Return False (and shut nothing down) if a thread is still running after
         ``timeout_sec``; :meth:`stuck` names its node.
         """
+        if not self._stopping.is_set():
+            self._stop_began = time.monotonic()
         self._stopping.set()
         for executor in self._executors:
             executor.wake()
@@ -417,7 +443,8 @@ def run_nodes(name: str, make_nodes: Callable[[Context], NodeGroup],
                 print('%s: invalid parameters: %s' % (name, error), file=sys.stderr)
                 return EXIT_BAD_PARAMETERS
             threads = ExecutorThreads(group.nodes, context, on_failure=signals.wake,
-                                      before_stop=group.before_stop)
+                                      before_stop=group.before_stop,
+                                      refusals=group.refusals)
             threads.start()
             signals.wait()
             _teardown(threads, group, timeout_sec)
