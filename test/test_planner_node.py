@@ -99,6 +99,12 @@ def test_topics_in_one_path_per_robot_out(planner, ros_client):
     assert response.duration.sec + response.duration.nanosec * 1e-9 == pytest.approx(
         expected.duration(0.5), abs=1e-9)
     assert len(response.paths) == 4
+    # Refused while the request's lists are gathered: named as the request labels them.
+    empty = ros_client.call(client, make_request([[], CONFIGURATIONS[2]],
+                                                 use_current_state=True))
+    assert empty.error_code == plan_sequence.Response.INVALID_REQUEST
+    assert empty.error_msg == ('configuration 1 (request configurations[0]) '
+                               'has no robots'), empty.error_msg
 
     assert ros_client.spin_until(
         lambda: all(s.last is not None for s in paths.values()) and domain.last is not None

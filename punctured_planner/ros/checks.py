@@ -50,17 +50,27 @@ class Gathered:
     samples_per_leg: int
 
     def label(self, m: int) -> str:
-        """
-        Return how every message names configuration m (0-based, the state first).
+        """Return how every message names configuration m (configuration_label)."""
+        return configuration_label(self.state, m)
 
-        With use_current_state, configuration 0 is the state (named with its
-        source) and configuration m is the request's configurations[m - 1].
-        """
-        if self.state is None:
-            return 'configuration %d' % m
-        if m == 0:
-            return 'configuration 0 (the current robot state from %s)' % self.state.source
-        return 'configuration %d (request configurations[%d])' % (m, m - 1)
+
+def configuration_label(state: RobotState | None, m: int) -> str:
+    """
+    Return how every message names configuration m (0-based, the state first).
+
+    With use_current_state (state given), configuration 0 is the state (named
+    with its source) and configuration m is the request's configurations[m - 1].
+    """
+    if state is None:
+        return 'configuration %d' % m
+    if m == 0:
+        return 'configuration 0 (the current robot state from %s)' % state.source
+    return 'configuration %d (request configurations[%d])' % (m, m - 1)
+
+
+def requested_state(request: Any, snapshot: Snapshot) -> RobotState | None:
+    """Return the robot state a request plans from: with use_current_state, the snapshot's."""
+    return snapshot.state if request.use_current_state else None
 
 
 @dataclass(frozen=True, eq=False)
@@ -90,7 +100,7 @@ def gather(request: Any, snapshot: Snapshot, now_ns: int) -> Gathered:
     settings = snapshot.settings
     configurations = list(request.configurations)
     use_state = bool(request.use_current_state)
-    state = snapshot.state if use_state else None
+    state = requested_state(request, snapshot)
     n = len(configurations) + (1 if use_state else 0)
     if n < 2:
         fail(ErrorCode.NO_CONFIGURATIONS,

@@ -12,6 +12,7 @@ response's error code in one place, :meth:`PlanSequenceHandler.handle`.
 """
 
 from collections import OrderedDict
+import functools
 import threading
 import time
 from typing import Any
@@ -24,7 +25,6 @@ from .settings import PlannerSettings
 from .snapshot import ObstacleSet
 from .snapshot import Outcome
 from .snapshot import Snapshot
-from .wording import ObstacleNames
 from .wording import RequestNames
 from .. import core
 from ..core import ErrorCode
@@ -88,9 +88,12 @@ class PlanSequenceHandler:
             return self._answer(response, gathered, checked, the_plan, snapshot.settings,
                                 now_ns, started)
         except PlanningError as error:
-            names = (RequestNames(snapshot.obstacles, gathered.label,
-                                  checked.planned if checked is not None else None)
-                     if gathered is not None else ObstacleNames(snapshot.obstacles))
+            # Before gathering ends, the request's own labels (the state first, with
+            # use_current_state) all the same.
+            label = (gathered.label if gathered is not None else functools.partial(
+                checks.configuration_label, checks.requested_state(request, snapshot)))
+            names = RequestNames(snapshot.obstacles, label,
+                                 checked.planned if checked is not None else None)
             conversions.fill_error(response, error.code, error.describe(names),
                                    time.perf_counter() - started, error.clearance, error.gap)
             return Outcome(response=response)
