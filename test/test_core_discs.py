@@ -268,6 +268,15 @@ def test_overlapping_bodies_are_refused_naming_the_culprits(configuration, code,
     assert caught.value.configuration == 1
 
 
+def test_a_distance_an_ulp_short_of_its_bound_is_written_in_full():
+    """Refused against 2R by an ulp: the message does not say 3.7 is less than 3.7."""
+    workspace = Workspace([[10.0, 10.0]], variant='discs', robot_radius=1.85)
+    with pytest.raises(PlanningError) as caught:
+        plan(workspace, [[[0.0, 0.0], [3.6999999999999997, 0.0]], [[0.0, 5.0], [5.0, 5.0]]])
+    assert ('centres 3.6999999999999997 apart, less than 2 robot_radius = 3.7'
+            in str(caught.value)), str(caught.value)
+
+
 @pytest.mark.parametrize('options, words', [
     ({'robot_radius': -0.1}, 'robot_radius must be 0 or a real number between'),
     ({'robot_radius': np.nan}, 'robot_radius must be 0 or a real number between'),

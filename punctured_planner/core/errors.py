@@ -86,6 +86,17 @@ class Wall:
         return float(bounds[self.axis, int(self.high)])
 
 
+def compared(value: float, bound: float) -> tuple[str, str]:
+    """
+    Return value and bound as a message writes them: 6 digits, or all where those agree.
+
+    A value refused against a bound it misses by an ulp must not read as equal to it:
+    'centres 3.7 apart, less than 2 robot_radius = 3.7' was 3.6999999999999997.
+    """
+    short = f'{value:.6g}', f'{bound:.6g}'
+    return short if short[0] != short[1] or value == bound else (repr(value), repr(bound))
+
+
 def literal(text: object) -> str:
     """Return text with its braces doubled: free text inside a message template."""
     return str(text).replace('{', '{{').replace('}', '}}')

@@ -13,7 +13,7 @@ import numpy as np
 import numpy.typing as npt
 from scipy.spatial import cKDTree
 
-from .errors import ErrorCode, literal, PlanningError
+from .errors import compared, ErrorCode, literal, PlanningError
 from .limits import first_out_of_range, MAX_COORDINATE
 from .pairs import pair_difference_matrix, point_pairs, with_obstacles
 from .walls import first_outside
@@ -220,17 +220,18 @@ def validate_configurations(configurations: npt.ArrayLike, obstacles: np.ndarray
                                           obstacle_radii)
     if overlap is not None:
         m, a, b, distance = overlap
+        apart, least = compared(distance, 2 * robot_radius)
         raise PlanningError(ErrorCode.ROBOTS_COINCIDE,
                             f'{{configuration}}: the discs of robots {a} and {b} overlap: '
-                            f'centres {distance:.6g} apart, less than 2 robot_radius = '
-                            f'{2 * robot_radius:.6g}', configuration=m, robots=[a, b])
+                            f'centres {apart} apart, less than 2 robot_radius = {least}',
+                            configuration=m, robots=[a, b])
     if on_obstacle is not None:
         m, robot, obstacle, distance = on_obstacle
+        apart, least = compared(distance, robot_radius + obstacle_radii[obstacle])
         raise PlanningError(ErrorCode.ROBOT_ON_OBSTACLE,
                             f'{{configuration}}: robot {robot} overlaps {{obstacle}}: '
-                            f'centres {distance:.6g} '
-                            f'apart, less than robot_radius + obstacle_radius = '
-                            f'{robot_radius + obstacle_radii[obstacle]:.6g}',
+                            f'centres {apart} apart, less than robot_radius + obstacle_radius '
+                            f'= {least}',
                             configuration=m, robots=[robot], obstacle=obstacle,
                             point=obstacles[obstacle].tolist())
     if bounds is not None:
