@@ -21,7 +21,7 @@ import numpy as np
 import yaml
 
 # Seconds a stopped node may take to exit: its shutdown.STOP_TIMEOUT_SEC plus margin.
-STOP_TIMEOUT_SEC = 40.0
+STOP_TIMEOUT_SEC = 70.0
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
 # The request of a cycle: n configurations of k robots (k drawn from ROBOTS), so a
 # signal sent within MAX_DELAY_SEC of the call lands before, during or after it.

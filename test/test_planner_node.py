@@ -439,17 +439,20 @@ def test_requests_waiting_past_the_stop_budget_are_answered_node_stopping(
     """
     A stop answers every request that reached the node: planned, or NODE_STOPPING at once.
 
-    The budget (STOP_PLANNING_SEC) set to 0: the request in flight is planned, the two
-    that wait behind it get NODE_STOPPING, and the stop ends cleanly (doc/design.md
-    section 16). Before, every waiting request was planned, and five large ones made
-    the stop overrun its timeout, exit 1 and lose three replies.
+    The budget (STOP_PLANNING_SEC) set to 0: the request in flight is planned, and
+    answered but not published, the two that wait behind it get NODE_STOPPING, and the
+    stop ends cleanly (doc/design.md section 16). Before, every waiting request was
+    planned and every plan published, and five large ones made the stop overrun its
+    timeout, exit 1 and lose three replies.
     """
     import threading
 
     import punctured_planner.core as core
     import punctured_planner.ros.runtime as runtime
     plan_sequence = _types()[0]
-    monkeypatch.setattr(runtime, 'STOP_PLANNING_SEC', 0.0)
+    import punctured_planner.nodes.planner as planner_module
+    for module in (runtime, planner_module):
+        monkeypatch.setattr(module, 'STOP_PLANNING_SEC', 0.0)
     taken = threading.Event()
     real_plan = core.plan
 
@@ -461,6 +464,7 @@ def test_requests_waiting_past_the_stop_budget_are_answered_node_stopping(
     monkeypatch.setattr(core, 'plan', slow_plan)
     node = InProcessPlanner(obstacles=flat(OBSTACLES))
     client = service_client(ros_client, node)
+    domain = Latest(ros_client.node, _types()[3], node.name('domain_index'))
     futures = [client.call_async(make_request()) for _ in range(3)]
     assert ros_client.spin_until(taken.is_set, 20)
     closing = threading.Thread(target=node.close)
@@ -473,6 +477,8 @@ def test_requests_waiting_past_the_stop_budget_are_answered_node_stopping(
     refused = [f.result() for f in futures if f.result().error_code]
     assert all('stopping' in r.error_msg and 'send it again' in r.error_msg for r in refused)
     assert all(len(r.paths) == 0 for r in refused)
+    assert not ros_client.spin_until(lambda: domain.last is not None, 2), \
+        'a plan answered past the budget is not published'
 
 
 def test_odometry_assembles_the_current_state(planner, ros_client):

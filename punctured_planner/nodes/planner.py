@@ -42,8 +42,10 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 import functools
 import gc
+import math
 import sys
 import threading
+import time
 import traceback
 from typing import Any
 import warnings
@@ -137,6 +139,7 @@ class PlannerNode(Node):
         self._send = self._service.send_response
         self._service.send_response = self._send_response  # type: ignore[method-assign]
         self._answering = 0  # the number of the request whose reply is being sent
+        self._stop_began: float | None = None  # time.monotonic() of the stop signal
         self._collecting = True  # whether the cyclic collector ran when it was taken
         self._after_reply: AfterReply | None = None  # what to publish once it is sent
         s = self._settings
@@ -267,6 +270,14 @@ class PlannerNode(Node):
             self._resume_collection()
             raise
 
+    def note_stop(self, began: float) -> None:
+        """Take the stop's start (NodeGroup.on_stop): past the budget, only replies go out."""
+        self._stop_began = began
+
+    def _into_stop(self) -> float:
+        """Return how long the node is into a stop (s); -inf while it runs."""
+        return -math.inf if self._stop_began is None else time.monotonic() - self._stop_began
+
     @property
     def plan_service_name(self) -> str:
         """Return the plan_sequence service's resolved name."""
@@ -353,7 +364,14 @@ class PlannerNode(Node):
             after, self._after_reply = self._after_reply, None
             if after is not None:
                 self._log_outcome(after)
-                if after.outcome.ok:
+                if after.outcome.ok and self._into_stop() > STOP_PLANNING_SEC:
+                    # Publishing the largest plan took 10 s more: the stop must end, and
+                    # the caller has its plan in the reply.
+                    self.get_logger().warning(
+                        'plan_sequence #%d: plan %d answered %.0f s into the stop: not '
+                        'published' % (after.number, after.outcome.plan_id,
+                                       self._into_stop()))
+                elif after.outcome.ok:
                     self._publish_after_reply(after)
 
     def _send_attempts(self, response, header, number, sequence):
@@ -436,7 +454,8 @@ def planner_nodes(context: Context | None = None, **kwargs: Any) -> NodeGroup:
     """Return the PlannerNode, its inputs and its outputs node: each spun in its own thread."""
     node = PlannerNode(context=context, **kwargs)
     return NodeGroup([node, node.inputs, node.outputs],
-                     refusals={node.plan_service_name: node.refuse_waiting})
+                     refusals={node.plan_service_name: node.refuse_waiting},
+                     on_stop=node.note_stop)
 
 
 def main(args: list[str] | None = None) -> int:

@@ -105,12 +105,14 @@ from .qos import load_fastdds_profile
 from .qos import SERVER_QOS
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
-# Seconds a callback in flight may take to finish after the stop signal.
-STOP_TIMEOUT_SEC = 30.0
-# Seconds after the stop signal within which a request that waits is still planned; a
-# later one gets the group's quick refusal (NodeGroup.refuse_waiting). A request within
-# max_poses (2,000,000 poses) took 18 s: five such waiting made the stop overrun
-# STOP_TIMEOUT_SEC, exit 1 and lose three replies (doc/design.md section 16).
+# Seconds a callback in flight may take to finish after the stop signal: the largest
+# request max_poses allows (2,000,000 poses) held the planner's thread 18 s on an idle
+# machine and more than 30 s at a load of 2 on 2 cores (doc/design.md section 16).
+STOP_TIMEOUT_SEC = 60.0
+# Seconds after the stop signal within which a node still does all its work: a request
+# that waits is planned (later, the group's quick refusal, NodeGroup.refusals), an
+# answered plan published (later, only the reply goes out, NodeGroup.on_stop). Five such
+# requests waiting made the stop overrun 30 s, exit 1 and lose three replies.
 STOP_PLANNING_SEC = 10.0
 # Seconds the participant stays after the last reply it wrote (step 3 of the stop),
 # unless no client of the services that replied is left: a reliable Fast DDS writer
@@ -207,13 +209,17 @@ class NodeGroup:
     ``refusals`` maps a service's name to ``refuse(request, response)``, which
     fills the reply of a request that waits past STOP_PLANNING_SEC into the
     stop: a quick answer instead of the service's own work (other services,
-    such as the parameter services, run their callback).
+    such as the parameter services, run their callback). ``on_stop(began)``
+    runs in the signal's thread as the stop begins, with its time.monotonic():
+    a callback in flight may then cut short what only matters while the node
+    runs.
     """
 
     nodes: Sequence[Node]
     before_stop: Optional[Callable[[], Optional[Future]]] = None
     before_teardown: Optional[Callable[[], None]] = None
     refusals: Mapping[str, Callable[[Any, Any], Any]] = field(default_factory=dict)
+    on_stop: Optional[Callable[[float], None]] = None
 
 
 class ExecutorThreads:
@@ -229,13 +235,15 @@ class ExecutorThreads:
     def __init__(self, nodes: Sequence[Node], context: Optional[Context] = None,
                  on_failure: Optional[Callable[[], None]] = None,
                  before_stop: Optional[Callable[[], Optional[Future]]] = None,
-                 refusals: Optional[Mapping[str, Callable[[Any, Any], Any]]] = None):
+                 refusals: Optional[Mapping[str, Callable[[Any, Any], Any]]] = None,
+                 on_stop: Optional[Callable[[float], None]] = None):
         """Make one executor per node (in ``context``); nothing spins yet."""
         self.nodes: List[Node] = list(nodes)
         self.failure: Optional[BaseException] = None
         self._on_failure = on_failure
         self._before_stop = before_stop
         self._refusals = dict(refusals or {})
+        self._on_stop = on_stop
         self._stopping = threading.Event()
         self._stop_began = 0.0  # time.monotonic() of the stop signal
         self._last_reply: Optional[float] = None  # time.monotonic() after the last reply
@@ -360,6 +368,8 @@ class ExecutorThreads:
         """
         if not self._stopping.is_set():
             self._stop_began = time.monotonic()
+            if self._on_stop is not None:
+                self._on_stop(self._stop_began)
         self._stopping.set()
         for executor in self._executors:
             executor.wake()
@@ -444,7 +454,7 @@ def run_nodes(name: str, make_nodes: Callable[[Context], NodeGroup],
                 return EXIT_BAD_PARAMETERS
             threads = ExecutorThreads(group.nodes, context, on_failure=signals.wake,
                                       before_stop=group.before_stop,
-                                      refusals=group.refusals)
+                                      refusals=group.refusals, on_stop=group.on_stop)
             threads.start()
             signals.wait()
             _teardown(threads, group, timeout_sec)
