@@ -369,6 +369,56 @@ def test_plan_message_round_trip_to_the_executor_reference():
         conversions.plan_reference(message)
 
 
+def _faulty_plan(fault):
+    """Return the Plan message of a request with one fault (its id 3)."""
+    from planner_helpers import make_request
+    from punctured_planner.cli import offline_plan
+    from punctured_planner.ros import conversions
+    from punctured_planner.ros.settings import PLANNER
+    settings = PLANNER.settings({'obstacles': [-2.0, 0.5, 0.0, 0.0, -0.5, 0.0,
+                                               2.5, 0.0, 0.0]})
+    outcome = offline_plan(make_request(max_speed=0.5), settings, now_ns=10 ** 18)
+    outcome.plan_id = 3
+    message = conversions.plan_message(outcome, settings)
+    if fault == 'paths':
+        message.paths = message.paths[:3]
+    elif fault == 'name':
+        message.robot_names = ['1bad'] + message.robot_names[1:]
+    elif fault == 'twice':
+        message.robot_names = ['robot_0'] * 4
+    elif fault == 'nan':
+        pose = message.paths[2].poses[1]
+        pose.pose.position.x = float('nan')
+    elif fault == 'back':
+        stamps = [p.header for p in message.paths[0].poses]
+        stamps[2].stamp, stamps[3].stamp = stamps[3].stamp, stamps[2].stamp
+    elif fault == 'radii':
+        message.obstacle_radii = [0.1] * 2
+    return message
+
+
+@pytest.mark.parametrize('fault, words', [
+    ('paths', 'plan 3 has 4 robot_names and 3 paths'),
+    ('name', "plan 3: robot_names: '1bad' is not a valid relative ROS name"),
+    ('twice', 'plan 3: robot_names must be unique'),
+    ('nan', 'plan 3: the path of robot_2 has a non-finite pose (pose 1)'),
+    ('back', 'plan 3: its stamps do not increase at pose 3'),
+    ('radii', 'plan 3 has 2 obstacle_radii for 3 obstacles'),
+])
+def test_a_plan_message_that_is_not_a_plan_is_refused_naming_the_fault(fault, words):
+    """
+    The executor's intake refuses it (ValueError): never a crash or a goal that runs wild.
+
+    Before, a name that is no ROS name crashed plan_executor when it subscribed to the
+    robot's odometry, a NaN pose made a goal command NaN velocities forever, stamps going
+    back ended a goal at once as executed, and one path for two names an IndexError.
+    """
+    from punctured_planner.ros import conversions
+    with pytest.raises(ValueError) as refused:
+        conversions.known_plan(_faulty_plan(fault))
+    assert words in str(refused.value), str(refused.value)
+
+
 def test_plan_message_carries_the_acceleration_limit_to_the_executor():
     """A planner max_acceleration > 0: the stamps' profile, and the executor's rebuild of it."""
     from planner_helpers import make_request

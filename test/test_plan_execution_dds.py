@@ -279,6 +279,27 @@ def test_plan_to_motion_over_dds(graph):
     # braking at 1 m/s^2 from at most 1 m/s
     assert client.spin_until(lambda: graph.speeds().max() < 1e-9, 1.5), graph.speeds()
 
+    # goals that wait for a plan not out yet: a cancel ends one at once, a newer goal
+    # preempts one; before, the cancel was accepted and ignored (the plan, once out, ran
+    # to its end) and a waiting goal, once its plan came, took over from the newer one
+    # running, which never got a result
+    waiting, _ = graph.send(50)
+    client.spin_until(lambda: False, 0.3)
+    asked = time.monotonic()
+    cancel = waiting.cancel_goal_async()
+    assert client.spin_until(cancel.done, 5)
+    result = graph.result(waiting)
+    assert result.error_code == result_type.CANCELED, result.error_msg
+    assert 'waiting for plan 50' in result.error_msg
+    assert time.monotonic() - asked < 2.0, 'a cancel does not wait for the plan'
+    first, _ = graph.send(51)
+    client.spin_until(lambda: False, 0.3)
+    second, _ = graph.send(52)
+    result = graph.result(first)
+    assert result.error_code == result_type.PREEMPTED, result.error_msg
+    assert 'waiting for plan 51' in result.error_msg
+    assert graph.result(second).error_code == result_type.NO_PLAN
+
     # Ctrl-C of the executor in the middle of a goal: exit 0, robots stopped
     graph.plan([GOAL])
     handle, feedback = graph.send(0)
@@ -341,3 +362,31 @@ def graph_vector(x, y):
     """Return a geometry_msgs/Vector3 (x, y, 0)."""
     from geometry_msgs.msg import Vector3
     return Vector3(x=float(x), y=float(y))
+
+
+def test_a_goal_waiting_for_its_plan_ends_stopped_at_a_stop(ros_client, ros_env, tmp_path):
+    """SIGINT while a goal waits for its plan: the goal ends STOPPED, exit 0 (no result lost)."""
+    import os
+
+    from punctured_planner_interfaces.action import ExecutePlan
+    from rclpy.action import ActionClient
+    namespace = '/pp_exec_wait_%d' % os.getpid()
+    executor = NodeProcess([venv_script('plan_executor'), '--ros-args', '-r',
+                            '__ns:=' + namespace], ros_env,
+                           str(tmp_path / 'plan_executor.log'), namespace)
+    action = ActionClient(ros_client.node, ExecutePlan, namespace + '/execute_plan')
+    try:
+        assert action.wait_for_server(timeout_sec=30), executor.log()
+        sent = action.send_goal_async(ExecutePlan.Goal(plan_id=99))
+        assert ros_client.spin_until(sent.done, 10) and sent.result().accepted
+        ros_client.spin_until(lambda: False, 0.3)
+        executor.proc.send_signal(signal.SIGINT)
+        result = sent.result().get_result_async()
+        assert ros_client.spin_until(result.done, 10), executor.log()
+        assert result.result().result.error_code == ExecutePlan.Result.STOPPED, executor.log()
+        assert 'waiting for plan 99' in result.result().result.error_msg
+        assert executor.proc.wait(timeout=10) == 0, executor.log()
+        assert 'Traceback' not in executor.log(), executor.log()
+    finally:
+        action.destroy()
+        executor.stop()

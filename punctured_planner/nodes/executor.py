@@ -32,7 +32,6 @@ sent zero velocity and the goal aborts with ``STOPPED`` (the runtime's
 zero velocity once more before the node goes.
 """
 
-from collections.abc import Iterable
 from dataclasses import dataclass
 from dataclasses import field
 import functools
@@ -93,6 +92,36 @@ class Run:
     stale: tuple = ()
     stale_since: int | None = None  # ns: the first control step of the current hold
     ended: Future = field(default_factory=Future)  # done once the goal's result is out
+    mode: str = 'velocity'  # the mode parameter as the goal started: it holds to the end
+
+
+@dataclass(eq=False)
+class PlanWait:
+    """A goal waiting for its plan: the plan id (0: any), and Futures for the wait's end."""
+
+    plan_id: int
+    goal: Any
+    heard: Future = field(default_factory=Future)  # done when the wait ends, for any reason
+    ended: Future = field(default_factory=Future)  # done once the goal's result is out
+
+    def wake(self) -> None:
+        """End the wait (its plan came, the time ran out, a cancel, a newer goal, a stop)."""
+        if not self.heard.done():
+            self.heard.set_result(True)
+
+
+def all_done(futures: list[Future]) -> Future:
+    """Return a Future that is done once every one of futures is."""
+    every = Future()
+
+    def check(_: Future) -> None:
+        if all(future.done() for future in futures) and not every.done():
+            every.set_result(True)
+
+    for future in futures:
+        future.add_done_callback(check)
+    check(every)
+    return every
 
 
 @dataclass(frozen=True)
@@ -115,9 +144,10 @@ class PlanExecutor(Node):
         self._odometry: dict[str, RobotOdometry] = {}
         self._links: dict[str, RobotLink] = {}
         self._run: Run | None = None
-        self._plan_waits: list[tuple[int, Future]] = []  # (plan id, 0: any; heard)
+        self._waits: list[PlanWait] = []  # the goals waiting for their plan
+        self._newest: ServerGoalHandle | None = None  # the goal that came last
         self._stopping = False  # the process is stopping: no new goal
-        self._halted: tuple = ()  # the robots of the goal ended by the stop
+        self._halted: Run | None = None  # the goal ended by the stop
         self.create_subscription(Plan, 'plan', self._on_plan, LATCHED)
         self._server = ActionServer(self, ExecutePlan, 'execute_plan', self._execute,
                                     goal_callback=self._on_goal,
@@ -142,9 +172,9 @@ class PlanExecutor(Node):
             self.get_logger().error('plan %d ignored: %s' % (msg.plan_id, error))
             return
         self._plans.add(plan)
-        for plan_id, heard in self._plan_waits:
-            if plan_id in (0, plan.plan_id) and not heard.done():
-                heard.set_result(True)
+        for wait in self._waits:
+            if wait.plan_id in (0, plan.plan_id):
+                wait.wake()
         for name in plan.names:
             self._link(name)
         self.get_logger().info('plan %d: %d robots, %.3f s, min gap %.6g m, tolerance %.6g m'
@@ -172,11 +202,14 @@ class PlanExecutor(Node):
         return GoalResponse.REJECT if self._stopping else GoalResponse.ACCEPT
 
     def _on_cancel(self, goal: ServerGoalHandle) -> CancelResponse:
-        """Accept a cancel of the active goal and stop every robot at once."""
+        """Accept a cancel: of the active goal, its robots stopped at once; of a waiting one."""
         run = self._run
         if run is not None and run.goal is goal:
             self._end(run, Result.CANCELED, 'canceled at plan time %.3f s'
                       % (run.execution.plan_time if run.execution else 0.0))
+        for wait in self._waits:
+            if wait.goal is goal:
+                wait.wake()
         return CancelResponse.ACCEPT
 
     async def _execute(self, goal: ServerGoalHandle) -> ExecutePlan.Result:
@@ -184,14 +217,20 @@ class PlanExecutor(Node):
         previous = self._run
         if previous is not None:
             self._end(previous, Result.PREEMPTED, 'preempted by a newer goal')
+        self._newest = goal
+        for waiting in self._waits:  # superseded: they end PREEMPTED (_waited)
+            waiting.wake()
         found = self._plans.lookup(goal.request.plan_id, self.resolve_topic_name('plan'))
+        wait = None
         if found.code == Result.NO_PLAN:
-            found = await self._wait_for_plan(goal.request.plan_id)
+            wait = PlanWait(goal.request.plan_id, goal)
+            found = await self._wait_for_plan(wait)
         run = None
         if found.runnable is not None:
             found = self._check_per_robot(found.runnable)
         if found.runnable is not None:
-            run = Run(goal, found.runnable, self.get_clock().now().nanoseconds)
+            run = Run(goal, found.runnable, self.get_clock().now().nanoseconds,
+                      mode=self._settings.mode)
             self._run = run
             result = await run.done
         else:
@@ -209,23 +248,35 @@ class PlanExecutor(Node):
             self.get_logger().info(line)
         else:
             self.get_logger().warning(line)
-        if run is not None:
-            # The action server sends the result as this coroutine returns, in the same step.
-            run.ended.set_result(True)
+        # The action server sends the result as this coroutine returns, in the same step.
+        for ended in (run, wait):
+            if ended is not None:
+                ended.ended.set_result(True)
         return result
 
-    async def _wait_for_plan(self, plan_id: int) -> Lookup:
-        """Wait up to PLAN_WAIT_SEC for plan ``plan_id`` (0: any) on ``plan``; look it up."""
-        heard = Future()
-        entry = (plan_id, heard)
-        self._plan_waits.append(entry)
-        timer = self.create_timer(PLAN_WAIT_SEC,
-                                  lambda: heard.done() or heard.set_result(False))
+    async def _wait_for_plan(self, wait: PlanWait) -> Lookup:
+        """
+        Wait up to PLAN_WAIT_SEC for the goal's plan (0: any) on ``plan``; look it up.
+
+        The wait ends early when the goal is canceled, a newer goal comes or the
+        process stops: then the goal ends CANCELED, PREEMPTED or STOPPED.
+        """
+        self._waits.append(wait)
+        timer = self.create_timer(PLAN_WAIT_SEC, wait.wake)
         try:
-            await heard
+            await wait.heard
         finally:
             self.destroy_timer(timer)
-            self._plan_waits.remove(entry)
+            self._waits.remove(wait)
+        plan_id = wait.plan_id
+        if wait.goal.is_cancel_requested:
+            return Lookup(None, Result.CANCELED, 'canceled while waiting for plan %d' % plan_id)
+        if self._stopping:
+            return Lookup(None, Result.STOPPED, 'plan_executor stopped while waiting for '
+                          'plan %d' % plan_id)
+        if self._newest is not wait.goal:
+            return Lookup(None, Result.PREEMPTED, 'preempted by a newer goal while waiting for '
+                          'plan %d' % plan_id)
         return self._plans.lookup(plan_id, self.resolve_topic_name('plan'))
 
     def _check_per_robot(self, plan: KnownPlan) -> Lookup:
@@ -245,7 +296,7 @@ class PlanExecutor(Node):
 
     def _end(self, run: Run, code: int, message: str) -> None:
         """Stop the run's robots, then end its goal with code and message."""
-        self._stop_robots(run.plan.names)
+        self._stop_robots(run)
         self._finish(run, code, message)
 
     def _finish(self, run: Run, code: int, message: str) -> None:
@@ -283,7 +334,7 @@ class PlanExecutor(Node):
         plan, settings = run.plan, self._settings
         state = fleet_state(plan, self._odometry, now, settings.odom_timeout)
         if state.wrong_frame:
-            self._stop_robots(plan.names)
+            self._stop_robots(run)
             self._finish(run, Result.FRAME_MISMATCH, state.wrong_frame)
             return
         execution = run.execution if run.execution is not None else self._start(run, state, now)
@@ -295,13 +346,13 @@ class PlanExecutor(Node):
                               state.stale_mask, state.orientations, state.ages)
         run.last_ns = now
         self._log_stale(run, state, step.plan_time)
-        self._publish_step(plan, step, state, now)
+        self._publish_step(run, step, state, now)
         run.goal.publish_feedback(ExecutePlan.Feedback(
             plan_time=step.plan_time, plan_duration=execution.reference.duration,
             clock_rate=step.rate, max_tracking_errors=execution.max_errors.tolist(),
             min_gap=float(execution.min_gap), stale_robots=list(state.stale)))
         if step.finished:
-            self._stop_robots(plan.names)
+            self._stop_robots(run)
             self._finish(run, Result.NONE, 'plan %d executed' % plan.plan_id)
 
     def _start(self, run: Run, state: FleetState, now: int) -> Execution | None:
@@ -358,16 +409,16 @@ class PlanExecutor(Node):
             self.get_logger().info('odometry back; plan clock resumes at %.3f s' % plan_time)
         run.stale = state.stale
 
-    def _publish_step(self, plan: KnownPlan, step: Step, state: FleetState,
-                      now_ns: int) -> None:
+    def _publish_step(self, run: Run, step: Step, state: FleetState, now_ns: int) -> None:
         """
         Publish every robot's reference pose and, in mode velocity, its body-frame command.
 
         A differential robot gets (forward, 0, 0) and its yaw rate: never a sideways part.
         """
+        plan = run.plan
         header = conversions.header(plan.frame_id, now_ns)
         body = Rotation.from_quat(state.orientations).apply(step.velocities, inverse=True)
-        velocity_mode = self._settings.mode == 'velocity'
+        velocity_mode = run.mode == 'velocity'
         for i, name in enumerate(plan.names):
             link = self._links[name]
             link.reference.publish(conversions.pose_stamped(header, step.positions[i],
@@ -380,32 +431,36 @@ class PlanExecutor(Node):
             else:
                 link.cmd_vel.publish(conversions.twist(body[i]))
 
-    def _stop_robots(self, names: Iterable[str]) -> None:
-        """Send zero velocity to every named robot (mode velocity)."""
-        if self._settings.mode != 'velocity':
+    def _stop_robots(self, run: Run) -> None:
+        """Send zero velocity to every robot of the run (mode velocity, as it started)."""
+        if run.mode != 'velocity':
             return
-        for name in names:
+        for name in run.plan.names:
             self._links[name].cmd_vel.publish(conversions.twist())
 
     def end_goals(self) -> Future | None:
         """
-        Refuse new goals; stop the active goal's robots, end it STOPPED (runtime before_stop).
+        Refuse new goals; end every goal STOPPED, the active one's robots stopped (before_stop).
 
-        Return the Future that is done once its result is out, None without a goal.
+        Return the Future that is done once every result is out, None without a goal.
         """
         self._stopping = True
+        ended = [wait.ended for wait in self._waits]
+        for wait in self._waits:
+            wait.wake()
         run = self._run
-        if run is None:
-            return None
-        self._halted = run.plan.names
-        self._end(run, Result.STOPPED, 'plan_executor stopped at plan time %.3f s; its '
-                  'robots were sent zero velocity'
-                  % (run.execution.plan_time if run.execution else 0.0))
-        return run.ended
+        if run is not None:
+            self._halted = run
+            self._end(run, Result.STOPPED, 'plan_executor stopped at plan time %.3f s; its '
+                      'robots were sent zero velocity'
+                      % (run.execution.plan_time if run.execution else 0.0))
+            ended.append(run.ended)
+        return all_done(ended) if ended else None
 
     def stop_halted_robots(self) -> None:
         """Send zero velocity again to the robots end_goals stopped: the last command they get."""
-        self._stop_robots(self._halted)
+        if self._halted is not None:
+            self._stop_robots(self._halted)
 
 
 def executor_nodes(context: Context | None = None, **kwargs: Any) -> NodeGroup:

@@ -58,6 +58,7 @@ from std_msgs.msg import UInt32
 
 from .cdr import serialized_paths
 from .goals import KnownPlan
+from .parameters import ros_names
 from .settings import PlannerSettings
 from .snapshot import Outcome
 from .snapshot import RobotOdometry
@@ -458,16 +459,31 @@ def plan_reference(msg: Plan) -> Reference:
     """
     Return the execution.Reference of a Plan message (seconds from its first stamp).
 
-    Raises ValueError when the paths do not share their stamps, as a plan's must.
+    Raises ValueError, naming the plan and the robot, unless the message is a
+    plan: one path per robot, the robots' names unique ROS names (each names
+    its topics), every position finite, and one clock: the same stamps on every
+    path, strictly increasing.
     """
+    if len(msg.robot_names) != len(msg.paths):
+        raise ValueError('plan %d has %d robot_names and %d paths, one per robot'
+                         % (msg.plan_id, len(msg.robot_names), len(msg.paths)))
+    ros_names('plan %d: robot_names' % msg.plan_id, tuple(msg.robot_names))
     arrays = [path_arrays(path) for path in msg.paths]
     stamps = [a[0] for a in arrays]
     if not stamps or stamps[0].size == 0:
         raise ValueError('plan %d has no poses' % msg.plan_id)
-    for name, robot_stamps in zip(msg.robot_names, stamps):
+    for name, (robot_stamps, positions, orientations) in zip(msg.robot_names, arrays):
         if not np.array_equal(robot_stamps, stamps[0]):
             raise ValueError('plan %d: the path of %s does not have the stamps of %s'
                              % (msg.plan_id, name, msg.robot_names[0]))
+        bad = np.flatnonzero(~np.isfinite(np.hstack([positions, orientations])).all(axis=1))
+        if bad.size:
+            raise ValueError('plan %d: the path of %s has a non-finite pose (pose %d)'
+                             % (msg.plan_id, name, bad[0]))
+    back = np.flatnonzero(np.diff(stamps[0]) <= 0)
+    if back.size:
+        raise ValueError('plan %d: its stamps do not increase at pose %d of %d'
+                         % (msg.plan_id, back[0] + 1, stamps[0].size))
     seconds = (stamps[0] - stamps[0][0]) * 1e-9
     positions = np.stack([a[1] for a in arrays], axis=1)
     orientations = normalized_quaternions(np.stack([a[2] for a in arrays], axis=1))
@@ -476,10 +492,17 @@ def plan_reference(msg: Plan) -> Reference:
 
 
 def plan_bodies(msg: Plan) -> Bodies:
-    """Return the execution.Bodies of a Plan message (robot radius, obstacles and radii)."""
+    """
+    Return the execution.Bodies of a Plan message (robot radius, obstacles and radii).
+
+    Raises ValueError unless there is one radius per obstacle.
+    """
     obstacles = np.array([(p.x, p.y, p.z) for p in msg.obstacles], dtype=float).reshape(-1, 3)
-    return Bodies(float(msg.robot_radius), obstacles,
-                  np.asarray(msg.obstacle_radii, dtype=float).reshape(-1))
+    radii = np.asarray(msg.obstacle_radii, dtype=float).reshape(-1)
+    if radii.size != len(obstacles):
+        raise ValueError('plan %d has %d obstacle_radii for %d obstacles, one per obstacle'
+                         % (msg.plan_id, radii.size, len(obstacles)))
+    return Bodies(float(msg.robot_radius), obstacles, radii)
 
 
 def known_plan(msg: Plan) -> KnownPlan:
