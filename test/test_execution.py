@@ -308,6 +308,23 @@ def test_holonomic_acceleration_limit_one_value_per_robot():
     assert np.allclose(one.velocities[0], [0.2, 0.0, 0.0])
 
 
+def test_new_obstacles_of_another_count_take_effect_at_the_next_step():
+    """fleet_sim's obstacles set to another count: the next step measures the new pairs."""
+    three = Bodies(0.2, np.array([[5.0, 0.0, 0.0], [6.0, 0.0, 0.0], [7.0, 0.0, 0.0]]),
+                   np.full(3, 0.1))
+    fleet = Fleet(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]]),
+                  FleetSettings(bodies=three, speed_limit=1.0))
+    fleet.step(0.0, 0.1)
+    one = Bodies(0.2, np.array([[1.25, 0.0, 0.0]]), np.full(1, 0.1))
+    fleet.configure(FleetSettings(bodies=one, speed_limit=1.0))
+    contacts = fleet.step(0.1, 0.1)  # robot 1 already overlaps the new pillar: not new
+    assert contacts == [] and fleet.min_gap == pytest.approx(-0.05)
+    fleet.command(0, [1.0, 0.0, 0.0], 0.2)
+    while not (contacts := fleet.step(0.2, 0.1)):
+        pass
+    assert [(c.kind, c.first, c.second) for c in contacts] == [('robots', 0, 1)]
+
+
 def test_without_the_shared_clock_the_slow_robot_falls_behind():
     reference, bodies, gap = certified_fleet()
     _, execution, _ = closed_loop(reference, bodies, gap, shared_clock=False)

@@ -85,14 +85,19 @@ class Fleet:
         self._active = np.zeros((k, 4))
         self._active_since = np.full(k, -np.inf)
         self._rng = np.random.default_rng(settings.seed)
-        gaps, _, _ = settings.bodies.pair_gaps(self.positions)
-        self._touching = gaps < 0
-        self.min_gap = float(gaps.min(initial=np.inf))
+        self.min_gap = float(settings.bodies.pair_gaps(self.positions)[0].min(initial=np.inf))
 
     def configure(self, settings: FleetSettings) -> None:
-        """Take new physics settings from the next command and step on (bodies stay)."""
+        """
+        Take new physics settings from the next command and step on (the robots stay).
+
+        New obstacles bring new pairs: which of them touch now is measured afresh, so
+        a contact is still reported once, when a pair starts touching (a new count of
+        obstacles failed every later step on the old pairs' array).
+        """
         k = len(self.positions)
         self.settings = settings
+        self._touching = settings.bodies.pair_gaps(self.positions)[0] < 0
         self.speed_factors = (np.ones(k) if settings.speed_factors is None
                               else np.asarray(settings.speed_factors, dtype=float))
         self.latencies = (np.zeros(k) if settings.latencies is None
