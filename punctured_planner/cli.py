@@ -285,10 +285,15 @@ def _plan(args):
     if not outcome.ok:
         return code
     title = os.path.basename(args.request) if args.request != '-' else None
-    written = render_outputs(args, outcome.planned().plan, title=title,
-                             max_speed=outcome.max_speed)
-    if args.mcap:
-        written.append(record_plan(args.mcap, outcome, settings))
+    try:
+        written = render_outputs(args, outcome.planned().plan, title=title,
+                                 max_speed=outcome.max_speed)
+        if args.mcap:
+            written.append(record_plan(args.mcap, outcome, settings))
+    except OSError as error:  # the plan is printed; an output file could not be written
+        print('punctured-planner: cannot write %s: %s' % (error.filename, error.strerror),
+              file=sys.stderr)
+        return EXIT_USAGE
     for path in written:
         print('# wrote %s' % path, file=sys.stderr)
     return code

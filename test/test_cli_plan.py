@@ -56,6 +56,14 @@ def test_plan_refusals_and_exit_codes(capsys, tmp_path):
     params.write_text('planner_node:\n  ros__parameters:\n    variant: fast\n', encoding='utf-8')
     code, data, err = run(capsys, 'plan', EXAMPLE, '--params', str(params))
     assert code == 2 and 'variant' in err
+    # parameters not a mapping; an output that cannot be written: exit 2, no traceback
+    params.write_text('/**/planner_node:\n  ros__parameters: [1, 2]\n', encoding='utf-8')
+    code, data, err = run(capsys, 'plan', EXAMPLE, '--params', str(params))
+    assert code == 2 and 'ros__parameters must map names to values' in err, err
+    nowhere = str(tmp_path / 'missing' / 'plan.mcap')
+    code, data, err = run(capsys, 'plan', EXAMPLE, '--no-paths', '--mcap', nowhere)
+    assert code == 2 and data['error_code'] == 0, err
+    assert 'punctured-planner: cannot write %s: ' % nowhere in err and 'Traceback' not in err
 
 
 def test_plan_png_and_mcap_from_the_console_script(tmp_path, ros_env):

@@ -14,8 +14,8 @@ KINDS = {'string': 'string', 'bool': 'bool', 'integer': 'integer', 'double': 'do
 
 def expected_row(spec):
     """Return the table row of one parameter, as msg_docs/parameters.md must show it."""
-    if isinstance(spec.default, list):
-        default = '`[]`'
+    if isinstance(spec.default, list):  # ['holonomic'] as YAML writes it, [] for none
+        default = '`[%s]`' % ', '.join(repr(item) for item in spec.default)
     elif isinstance(spec.default, str):
         default = "`'%s'`" % spec.default
     else:

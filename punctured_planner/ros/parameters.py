@@ -342,5 +342,9 @@ def load_parameter_file(path: str, node_name: str) -> dict:
             continue
         if not isinstance(section, dict) or 'ros__parameters' not in section:
             raise ValueError('%s: section %r has no ros__parameters' % (path, key))
-        values.update(section['ros__parameters'] or {})
+        parameters = section['ros__parameters'] or {}
+        if not isinstance(parameters, dict):
+            raise ValueError('%s: section %r: ros__parameters must map names to values, got %r'
+                             % (path, key, parameters))
+        values.update(parameters)
     return values
