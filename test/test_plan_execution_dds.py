@@ -96,6 +96,7 @@ class Graph:
         self.plan_sequence = node.create_client(PlanSequence, self.name('plan_sequence'))
         self.action = ActionClient(node, ExecutePlan, self.name('execute_plan'))
         self.sim_parameters = AsyncParameterClient(node, self.name('fleet_sim'))
+        self.executor_parameters = AsyncParameterClient(node, self.name('plan_executor'))
         self.odometry = {}
         self.commands = {name: [] for name in NAMES}
         for name in NAMES:
@@ -115,6 +116,7 @@ class Graph:
         client.wait_for_service(self.plan_sequence, 30)
         assert self.action.wait_for_server(timeout_sec=30), self.logs()
         assert self.sim_parameters.wait_for_services(timeout_sec=30), self.logs()
+        assert self.executor_parameters.wait_for_services(timeout_sec=30), self.logs()
         assert client.spin_until(lambda: len(self.odometry) == len(NAMES), 30), self.logs()
 
     def name(self, relative):
@@ -148,8 +150,15 @@ class Graph:
 
     def set_sim(self, **values):
         """Set fleet_sim parameters; fail unless every one is accepted."""
+        self._set(self.sim_parameters, values)
+
+    def set_executor(self, **values):
+        """Set plan_executor parameters; fail unless every one is accepted."""
+        self._set(self.executor_parameters, values)
+
+    def _set(self, parameters, values):
         from rclpy.parameter import Parameter
-        future = self.sim_parameters.set_parameters(
+        future = parameters.set_parameters(
             [Parameter(name, value=value) for name, value in values.items()])
         assert self.client.spin_until(future.done, 10)
         assert all(r.successful for r in future.result().results), future.result()
@@ -267,6 +276,9 @@ def test_plan_to_motion_over_dds(graph):
     assert graph.plan([START]).plan_id == 2
     assert client.spin_until(lambda: feedback and feedback[-1][1].plan_time > 1.0, 20)
     assert graph.speeds().max() > 0.1
+    # the mode holds for the goal's whole run: switched to reference now, the goal still
+    # commands its robots, and the cancel still sends them zero (it sent nothing before)
+    graph.set_executor(mode='reference')
     cancel = handle.cancel_goal_async()
     asked = time.monotonic()
     assert client.spin_until(cancel.done, 5)
@@ -278,6 +290,7 @@ def test_plan_to_motion_over_dds(graph):
         assert last[0] - asked < 0.2 and last[1].linear.x == last[1].linear.y == 0.0, name
     # braking at 1 m/s^2 from at most 1 m/s
     assert client.spin_until(lambda: graph.speeds().max() < 1e-9, 1.5), graph.speeds()
+    graph.set_executor(mode='velocity')
 
     # goals that wait for a plan not out yet: a cancel ends one at once, a newer goal
     # preempts one; before, the cancel was accepted and ignored (the plan, once out, ran
