@@ -53,10 +53,12 @@ The stop, in the order of doc/design.md section 16: (1) no new work: the
 threads leave their loop after the callback in flight, and the group's
 ``before_stop`` hook (run in the first node's thread) makes its node refuse
 goals; (2) what is in flight finishes: the plan call in flight writes its
-reply, each thread answers the service requests that had already arrived,
-and the hook ends the goal in flight while its thread spins on until the
-Future it returned is done (the result sent), at most ``STOP_DRAIN_SEC``, and
-``REQUEST_GRACE_SEC`` more for a result request still on the wire;
+reply, each thread answers the service requests that had already arrived
+(within ``STOP_PLANNING_SEC`` of the signal as the service would, later with
+the group's quick refusal, ``NodeGroup.refusals``), and the hook ends the goal
+in flight while its thread spins on until the Future it returned is done (the
+result sent), at most ``STOP_DRAIN_SEC``, and ``REQUEST_GRACE_SEC`` more for a
+result request still on the wire;
 (3) the participant stays until ``REPLY_GRACE_SEC`` after the last reply
 written (a service's response or an action server's), so that the DDS writer
 can still resend it at its next heartbeat to a client that missed part of it,
@@ -228,8 +230,8 @@ class ExecutorThreads:
 
     ``start()`` once, then ``close()`` (or ``stop()`` and destroy the nodes
     yourself). ``on_failure`` is called from the thread of a callback that
-    raised; the exception is in :attr:`failure` and the logs. ``before_stop``
-    is :attr:`NodeGroup.before_stop`.
+    raised; the exception is in :attr:`failure` and the logs. ``before_stop``,
+    ``refusals`` and ``on_stop`` are the NodeGroup's.
     """
 
     def __init__(self, nodes: Sequence[Node], context: Optional[Context] = None,
