@@ -26,6 +26,8 @@ def test_values_take_the_parameter_kinds():
     ({'robot_names': ['a', 'a']}, 'unique'), ({'robot_names': ['a b']}, 'ROS name'),
     ({'robot_names': ['a'], 'robot_count': 2}, 'robot_count'),
     ({'frame_id': ''}, 'frame_id'), ({'lane_spacing': 0.0}, 'lane_spacing'),
+    ({'frame_id': 'bad frame'}, "frame_id 'bad frame' is not a frame id"),
+    ({'frame_id': '/map'}, "tf2 takes no leading '/'"),
     ({'max_speed': True}, 'max_speed'), ({'dimension': 2.0}, 'integer'),
     ({'nonsense': 1}, 'unknown'), ({'robot_count': 5, 'max_robots': 4}, 'max_robots'),
     ({'refine': 1}, 'refine must be true or false'),

@@ -154,10 +154,13 @@ def _coerce(spec: Spec, value: object) -> Any:
 
 # ---------------------------------------------------------------- checks of one value
 
-def non_empty(name: str, value: str) -> None:
-    """Refuse an empty string."""
+def frame_name(name: str, value: str) -> None:
+    """Refuse what tf2 cannot take as a frame id: empty, with whitespace, or a leading '/'."""
     if not value:
         raise ValueError('%s must not be empty' % name)
+    if value.startswith('/') or any(character.isspace() for character in value):
+        raise ValueError("%s %r is not a frame id: tf2 takes no leading '/' and no "
+                         'whitespace' % (name, value))
 
 
 def triples(name: str, value: tuple) -> None:
@@ -197,7 +200,8 @@ def within(low: float, high: float) -> Callable[[str, tuple], None]:
 FRAME_ID = Spec(
     'frame_id', 'string', 'map',
     'The planning frame: frame_id of every message the node publishes; inputs with a '
-    'non-empty header.frame_id must name it.', check=non_empty, prose='non-empty')
+    'non-empty header.frame_id must name it.', check=frame_name,
+    prose="non-empty, no whitespace, no leading '/'")
 OBSTACLES = Spec(
     'obstacles', 'double_array', [],
     'Obstacle centres as a flat list x0, y0, z0, x1, y1, z1, ...; for planner_node the '
