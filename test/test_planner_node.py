@@ -481,6 +481,43 @@ def test_requests_waiting_past_the_stop_budget_are_answered_node_stopping(
         'a plan answered past the budget is not published'
 
 
+def test_parameters_answer_while_a_plan_runs(planner, ros_client, monkeypatch):
+    """
+    ros2 param get is answered while plan_sequence plans: the service has a node of its own.
+
+    A 2,000,000-pose request held the service's thread 18 s, and a parameter get waited
+    16 s behind it when the node served both.
+    """
+    import threading
+
+    import punctured_planner.core as core
+    from rclpy.parameter_client import AsyncParameterClient
+    taken, release = threading.Event(), threading.Event()
+    real_plan = core.plan
+
+    def held_plan(*args, **kwargs):
+        taken.set()
+        release.wait(20)  # a long plan
+        return real_plan(*args, **kwargs)
+
+    monkeypatch.setattr(core, 'plan', held_plan)
+    node = planner(obstacles=flat(OBSTACLES))
+    client = service_client(ros_client, node)
+    remote = AsyncParameterClient(ros_client.node, node.name('planner_node'))
+    assert remote.wait_for_services(timeout_sec=20)
+    planned = client.call_async(make_request())
+    try:
+        assert ros_client.spin_until(taken.is_set, 20)
+        got = remote.get_parameters(['max_speed'])
+        assert ros_client.spin_until(got.done, 5), 'parameters wait for the plan'
+        assert got.result().values[0].double_value == node.node.get_parameter('max_speed').value
+        assert not planned.done()
+    finally:
+        release.set()
+    assert ros_client.spin_until(planned.done, 20)
+    assert planned.result().error_code == 0, planned.result().error_msg
+
+
 def test_odometry_assembles_the_current_state(planner, ros_client):
     """With robot_names, each <name>/odom feeds the current state (frame checked)."""
     plan_sequence, _, _, _, _, odometry = _types()

@@ -86,7 +86,7 @@ def test_invalid_parameters_stop_the_node(planner_process, arguments):
 
 
 def test_renamed_node_keeps_its_companion_apart(planner_process, ros_client):
-    """Under -r __node:=NAME (a launch name=) the companions are NAME_inputs, NAME_outputs."""
+    """Under -r __node:=NAME (a launch name=) the companions are NAME_server, _inputs, _outputs."""
     from punctured_planner_interfaces.srv import PlanSequence
     node = planner_process('-r', '__node:=fleet_planner')
     client = ros_client.node.create_client(PlanSequence, node.name('plan_sequence'))
@@ -96,8 +96,9 @@ def test_renamed_node_keeps_its_companion_apart(planner_process, ros_client):
     def names():
         return [name for name, ns in ros_client.node.get_node_names_and_namespaces()
                 if ns == namespace]
-    assert ros_client.spin_until(lambda: len(names()) >= 3, 10), names()
-    assert sorted(names()) == ['fleet_planner', 'fleet_planner_inputs', 'fleet_planner_outputs']
+    assert ros_client.spin_until(lambda: len(names()) >= 4, 10), names()
+    assert sorted(names()) == ['fleet_planner', 'fleet_planner_inputs', 'fleet_planner_outputs',
+                               'fleet_planner_server']
     assert node.stop() == 0, node.log()
 
 
