@@ -291,8 +291,8 @@ def _plan(args):
         if args.mcap:
             written.append(record_plan(args.mcap, outcome, settings))
     except OSError as error:  # the plan is printed; an output file could not be written
-        print('punctured-planner: cannot write %s: %s' % (error.filename, error.strerror),
-              file=sys.stderr)
+        print('punctured-planner: cannot write the outputs (--png, --gif, --mcap): %s'
+              % error, file=sys.stderr)
         return EXIT_USAGE
     for path in written:
         print('# wrote %s' % path, file=sys.stderr)

@@ -275,6 +275,12 @@ def test_a_distance_an_ulp_short_of_its_bound_is_written_in_full():
         plan(workspace, [[[0.0, 0.0], [3.6999999999999997, 0.0]], [[0.0, 5.0], [5.0, 5.0]]])
     assert ('centres 3.6999999999999997 apart, less than 2 robot_radius = 3.7'
             in str(caught.value)), str(caught.value)
+    pillar = Workspace([[0.0, 0.0], [10.0, 10.0]], variant='discs', robot_radius=0.2,
+                       obstacle_radius=0.1)  # 0.2 + 0.1 is 0.30000000000000004
+    with pytest.raises(PlanningError) as caught:
+        plan(pillar, [[[0.3, 0.0], [5.0, 0.0]], [[0.0, 5.0], [5.0, 5.0]]])
+    assert ('centres 0.3 apart, less than robot_radius + obstacle_radius = '
+            '0.30000000000000004' in str(caught.value)), str(caught.value)
 
 
 @pytest.mark.parametrize('options, words', [

@@ -527,11 +527,13 @@ def test_subnormal_scale_certificate_is_exact(variant):
                             'got None'),
     ({'lane_spacing': '0.1'}, "got '0.1'"),
     ({'lane_spacing': [1.0]}, 'got [1.0]'),
+    ({'lane_spacing': True}, 'got True'),
     ({'required_clearance': 1e-200}, 'required_clearance must be 0 or a real number between'),
     ({'robot_radius': 1e16}, 'robot_radius must be 0 or a real number between'),
     ({'obstacle_radius': [0.1, 1e-120]}, 'obstacle 1: obstacle_radius must be 0 or'),
     ({'bounds': [[-1e308, 1e308], [-1.0, 1.0]]}, 'x_min = -1e+308 is beyond the supported'),
-    ({'dimension': 2.5}, 'dimension must be an integer or None, got 2.5'),
+    ({'dimension': 2.5}, 'dimension must be an integer >= 2 or None, got 2.5'),
+    ({'obstacles': [], 'dimension': 1}, 'dimension must be an integer >= 2 or None, got 1'),
     ({'frame': ([0, 0], [1, 0])}, 'frame must be a Frame or (origin, e1, e2)'),
     ({'obstacles': [[1.0, 2.0], [3.0]]}, 'the obstacle array is not an array of real numbers'),
     ({'obstacles': [[1 + 1j, 0.0]]}, 'the obstacle array is not an array of real numbers'),
@@ -550,5 +552,5 @@ def test_the_ends_of_the_supported_lengths_are_accepted():
     for length in (1e-100, 1e15):
         Workspace([[0.0, 0.0]], variant='discs', lane_spacing=length, min_spacing=length,
                   required_clearance=length, robot_radius=length, obstacle_radius=length)
-    Workspace([[0.0, 0.0]], variant='discs', required_clearance=0, robot_radius=0,
+    Workspace([[0.0, 0.0]], variant='discs', required_clearance=0, robot_radius=np.array(0.2),
               obstacle_radius=np.float32(0))

@@ -450,9 +450,7 @@ def test_requests_waiting_past_the_stop_budget_are_answered_node_stopping(
     import punctured_planner.core as core
     import punctured_planner.ros.runtime as runtime
     plan_sequence = _types()[0]
-    import punctured_planner.nodes.planner as planner_module
-    for module in (runtime, planner_module):
-        monkeypatch.setattr(module, 'STOP_PLANNING_SEC', 0.0)
+    monkeypatch.setattr(runtime, 'STOP_PLANNING_SEC', 0.0)
     taken = threading.Event()
     real_plan = core.plan
 

@@ -93,6 +93,7 @@ def compared(value: float, bound: float) -> tuple[str, str]:
     A value refused against a bound it misses by an ulp must not read as equal to it:
     'centres 3.7 apart, less than 2 robot_radius = 3.7' was 3.6999999999999997.
     """
+    value, bound = float(value), float(bound)  # repr of a numpy float names its type
     short = f'{value:.6g}', f'{bound:.6g}'
     return short if short[0] != short[1] or value == bound else (repr(value), repr(bound))
 

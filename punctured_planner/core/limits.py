@@ -53,10 +53,14 @@ def checked_length(value: object, name: str, zero: bool) -> float:
     """
     Return value as a float length, or raise INVALID_REQUEST naming it and its range.
 
-    A real number (Python's or numpy's) between MIN_LENGTH and MAX_COORDINATE,
-    or with zero 0; anything else (a string, None, a list, NaN) is refused.
+    A real number (Python's or numpy's, or a 0-d array of one) between MIN_LENGTH
+    and MAX_COORDINATE, or with zero 0; anything else (a bool, a string, None, a
+    list, NaN) is refused.
     """
-    if isinstance(value, numbers.Real) and lengths_in_range(np.array(float(value)), zero):
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value.item()  # a 0-d array holds one number
+    if (isinstance(value, numbers.Real) and not isinstance(value, bool)
+            and lengths_in_range(np.array(float(value)), zero)):
         return float(value)
     raise PlanningError(ErrorCode.INVALID_REQUEST,
                         f'{name} must be {length_range(zero)}, got '

@@ -59,9 +59,10 @@ class Workspace:
                  bounds: npt.ArrayLike | None = None) -> None:
         """Validate the obstacles and options and fix the frame."""
         if dimension is not None and (isinstance(dimension, bool)
-                                      or not isinstance(dimension, numbers.Integral)):
+                                      or not isinstance(dimension, numbers.Integral)
+                                      or dimension < 2):
             raise PlanningError(ErrorCode.INVALID_REQUEST,
-                                f'dimension must be an integer or None, got '
+                                f'dimension must be an integer >= 2 or None, got '
                                 f'{literal(repr(dimension))}')
         obstacles = real_array(obstacles, 'the obstacle array')
         if obstacles.size == 0:
@@ -71,16 +72,15 @@ class Workspace:
                 raise PlanningError(ErrorCode.INVALID_REQUEST,
                                     f'obstacles of shape {obstacles.shape} do not give the '
                                     f'dimension d: pass dimension=d or a (0, d) array')
-            if dimension < 2:
-                raise PlanningError(ErrorCode.INVALID_REQUEST,
-                                    'the dimension d must be at least 2')
             obstacles = obstacles.reshape(0, dimension)
         if obstacles.ndim != 2 or (dimension is not None and obstacles.shape[1] != dimension):
             raise PlanningError(ErrorCode.INVALID_REQUEST,
                                 f'obstacles must have shape (r, d), got {obstacles.shape}')
         self.dimension = int(obstacles.shape[1])
         if self.dimension < 2:
-            raise PlanningError(ErrorCode.INVALID_REQUEST, 'the dimension d must be at least 2')
+            raise PlanningError(ErrorCode.INVALID_REQUEST,
+                                f'obstacles of shape {obstacles.shape}: the dimension d must '
+                                f'be at least 2')
         bad = np.argwhere(~np.isfinite(obstacles))
         if bad.size:
             raise PlanningError(ErrorCode.NON_FINITE_VALUE,

@@ -26,10 +26,14 @@ stale for longer than ``hold_timeout`` (``ODOMETRY_LOST``: the clock held that
 long, every robot is sent zero velocity). A stale robot gets zero velocity from
 the first control step that finds its odometry older than ``odom_timeout``.
 Everything runs on one single-threaded executor, so callbacks never overlap.
+A goal still waiting for its plan ends at once when canceled (``CANCELED``),
+when a newer goal comes (``PREEMPTED``: the newest goal always wins) or at a
+stop; the mode (``velocity`` or ``reference``) holds for a goal's whole run.
 On Ctrl-C or SIGTERM new goals are rejected, the active goal's robots are
-sent zero velocity and the goal aborts with ``STOPPED`` (the runtime's
-``before_stop`` hook, while the node still spins); ``before_teardown`` sends
-zero velocity once more before the node goes.
+sent zero velocity, and every accepted goal (running, waiting, or not started
+yet) ends with ``STOPPED`` (the runtime's ``before_stop`` hook, while the node
+still spins, until every result is out); ``before_teardown`` sends zero
+velocity once more before the node goes.
 """
 
 from dataclasses import dataclass
@@ -85,24 +89,22 @@ class Run:
     goal: Any
     plan: KnownPlan
     requested_ns: int
+    mode: str  # the mode parameter as the goal started: it holds to the end
     done: Future = field(default_factory=Future)
     execution: Execution | None = None
     started_ns: int = 0
     last_ns: int = 0
     stale: tuple = ()
     stale_since: int | None = None  # ns: the first control step of the current hold
-    ended: Future = field(default_factory=Future)  # done once the goal's result is out
-    mode: str = 'velocity'  # the mode parameter as the goal started: it holds to the end
 
 
 @dataclass(eq=False)
 class PlanWait:
-    """A goal waiting for its plan: the plan id (0: any), and Futures for the wait's end."""
+    """A goal waiting for its plan: the plan id (0: any), and a Future for the wait's end."""
 
     plan_id: int
     goal: Any
     heard: Future = field(default_factory=Future)  # done when the wait ends, for any reason
-    ended: Future = field(default_factory=Future)  # done once the goal's result is out
 
     def wake(self) -> None:
         """End the wait (its plan came, the time ran out, a cancel, a newer goal, a stop)."""
@@ -148,9 +150,13 @@ class PlanExecutor(Node):
         self._newest: ServerGoalHandle | None = None  # the goal that came last
         self._stopping = False  # the process is stopping: no new goal
         self._halted: Run | None = None  # the goal ended by the stop
+        # Every accepted goal by its id, until its result is out: done then (end_goals waits
+        # for it). Goal handles compare by value and are not hashable.
+        self._results: dict[bytes, Future] = {}
         self.create_subscription(Plan, 'plan', self._on_plan, LATCHED)
         self._server = ActionServer(self, ExecutePlan, 'execute_plan', self._execute,
                                     goal_callback=self._on_goal,
+                                    handle_accepted_callback=self._on_accepted,
                                     cancel_callback=self._on_cancel)
         self._timer = self.create_timer(1.0 / self._settings.control_rate, self._control)
         self.get_logger().info('serving %s, mode %s, control at %g Hz'
@@ -159,7 +165,7 @@ class PlanExecutor(Node):
 
     @property
     def _settings(self) -> ExecutorSettings:
-        """Return the accepted parameters: a change applies from the next control step on."""
+        """Return the accepted parameters: the mode holds per goal, the rest per step."""
         return self._node_parameters.settings
 
     # ------------------------------------------------------------ inputs
@@ -201,6 +207,11 @@ class PlanExecutor(Node):
         """Accept every goal, unless the process is stopping."""
         return GoalResponse.REJECT if self._stopping else GoalResponse.ACCEPT
 
+    def _on_accepted(self, goal: ServerGoalHandle) -> None:
+        """Note an accepted goal until its result is out, then execute it."""
+        self._results[bytes(goal.goal_id.uuid)] = Future()
+        goal.execute()
+
     def _on_cancel(self, goal: ServerGoalHandle) -> CancelResponse:
         """Accept a cancel: of the active goal, its robots stopped at once; of a waiting one."""
         run = self._run
@@ -214,6 +225,19 @@ class PlanExecutor(Node):
 
     async def _execute(self, goal: ServerGoalHandle) -> ExecutePlan.Result:
         """Run one goal to its end; return its ExecutePlan result."""
+        try:
+            return await self._goal_result(goal)
+        finally:
+            # The action server sends the result as this coroutine returns, in the same step.
+            self._results.pop(bytes(goal.goal_id.uuid), Future()).set_result(True)
+
+    async def _goal_result(self, goal: ServerGoalHandle) -> ExecutePlan.Result:
+        """Return a goal's result, its goal handle ended (succeed, canceled or abort)."""
+        if goal.is_cancel_requested or self._stopping:  # before it started
+            return self._ended(goal, Lookup(None, Result.CANCELED, 'canceled before it started')
+                               if goal.is_cancel_requested else Lookup(
+                                   None, Result.STOPPED, 'plan_executor stopped before the '
+                                   'goal started'))
         previous = self._run
         if previous is not None:
             self._end(previous, Result.PREEMPTED, 'preempted by a newer goal')
@@ -225,17 +249,24 @@ class PlanExecutor(Node):
         if found.code == Result.NO_PLAN:
             wait = PlanWait(goal.request.plan_id, goal)
             found = await self._wait_for_plan(wait)
-        run = None
         if found.runnable is not None:
             found = self._check_per_robot(found.runnable)
-        if found.runnable is not None:
-            run = Run(goal, found.runnable, self.get_clock().now().nanoseconds,
-                      mode=self._settings.mode)
-            self._run = run
-            result = await run.done
-        else:
-            result = Result(error_code=found.code, error_msg=found.message,
-                            plan_id=found.plan.plan_id if found.plan else goal.request.plan_id)
+        if found.runnable is None:
+            return self._ended(goal, found)
+        run = Run(goal, found.runnable, self.get_clock().now().nanoseconds,
+                  mode=self._settings.mode)
+        self._run = run
+        return self._finished(goal, await run.done)
+
+    def _ended(self, goal: ServerGoalHandle, found: Lookup) -> ExecutePlan.Result:
+        """End a goal that does not run with its Lookup's code and message."""
+        return self._finished(goal, Result(
+            error_code=found.code, error_msg=found.message,
+            plan_id=found.plan.plan_id if found.plan else goal.request.plan_id))
+
+    def _finished(self, goal: ServerGoalHandle,
+                  result: ExecutePlan.Result) -> ExecutePlan.Result:
+        """End the goal handle as its result says (succeed, canceled or abort); log it."""
         if result.error_code == Result.NONE:
             goal.succeed()
         elif result.error_code == Result.CANCELED and goal.is_cancel_requested:
@@ -248,10 +279,6 @@ class PlanExecutor(Node):
             self.get_logger().info(line)
         else:
             self.get_logger().warning(line)
-        # The action server sends the result as this coroutine returns, in the same step.
-        for ended in (run, wait):
-            if ended is not None:
-                ended.ended.set_result(True)
         return result
 
     async def _wait_for_plan(self, wait: PlanWait) -> Lookup:
@@ -442,10 +469,11 @@ class PlanExecutor(Node):
         """
         Refuse new goals; end every goal STOPPED, the active one's robots stopped (before_stop).
 
-        Return the Future that is done once every result is out, None without a goal.
+        Every accepted goal: running, waiting for its plan, or not started yet (it ends
+        as it starts). Return the Future that is done once every result is out, None
+        without a goal.
         """
         self._stopping = True
-        ended = [wait.ended for wait in self._waits]
         for wait in self._waits:
             wait.wake()
         run = self._run
@@ -454,8 +482,8 @@ class PlanExecutor(Node):
             self._end(run, Result.STOPPED, 'plan_executor stopped at plan time %.3f s; its '
                       'robots were sent zero velocity'
                       % (run.execution.plan_time if run.execution else 0.0))
-            ended.append(run.ended)
-        return all_done(ended) if ended else None
+        pending = [ended for ended in self._results.values() if not ended.done()]
+        return all_done(pending) if pending else None
 
     def stop_halted_robots(self) -> None:
         """Send zero velocity again to the robots end_goals stopped: the last command they get."""

@@ -27,8 +27,8 @@ both shared one. Not rclpy's MultiThreadedExecutor: in rclpy 7.1 it busy-
 loops on subscription traffic (ros2/rclpy#1223, #1452), and measured here, with
 obstacles and robot states at 50 Hz, service round trips went from 4 ms to 80
 ms median with stalls of 2-6 s (two single-threaded executors: 3.4 ms, worst 6
-ms). The publishers live on a third node, ``<name>_outputs``, spun by a third
-thread, which wakes only when one of their QoS events fires (rclpy's default
+ms). The publishers live on a third companion, ``<name>_outputs``, spun by a
+fourth thread, which wakes only when one of their QoS events fires (rclpy's default
 handlers log a subscriber with incompatible QoS or type, two per publisher).
 rclpy 7.1's executor looks each waitable of its nodes up in a plain list after
 every wake-up: with one latched Path per robot, 1,026 waitables cost 7.7 ms per
@@ -45,7 +45,6 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 import functools
 import gc
-import math
 import sys
 import threading
 import time
@@ -75,6 +74,7 @@ from ..ros.qos import LATCHED
 from ..ros.qos import SERVER_QOS
 from ..ros.qos import STATE
 from ..ros.runtime import NodeGroup
+from ..ros.runtime import past_planning_budget
 from ..ros.runtime import run_nodes
 from ..ros.runtime import STOP_PLANNING_SEC
 from ..ros.settings import PLANNER
@@ -279,14 +279,10 @@ class PlannerNode(Node):
         """Take the stop's start (NodeGroup.on_stop): past the budget, only replies go out."""
         self._stop_began = began
 
-    def _into_stop(self) -> float:
-        """Return how long the node is into a stop (s); -inf while it runs."""
-        return -math.inf if self._stop_began is None else time.monotonic() - self._stop_began
-
     @property
     def plan_service_name(self) -> str:
         """Return the plan_sequence service's resolved name."""
-        return self._service.srv_name
+        return self._service.service_name
 
     def refuse_waiting(self, request: PlanSequence.Request,
                        response: PlanSequence.Response) -> PlanSequence.Response:
@@ -369,13 +365,13 @@ class PlannerNode(Node):
             after, self._after_reply = self._after_reply, None
             if after is not None:
                 self._log_outcome(after)
-                if after.outcome.ok and self._into_stop() > STOP_PLANNING_SEC:
+                if after.outcome.ok and past_planning_budget(self._stop_began):
                     # Publishing the largest plan took 10 s more: the stop must end, and
                     # the caller has its plan in the reply.
                     self.get_logger().warning(
                         'plan_sequence #%d: plan %d answered %.0f s into the stop: not '
                         'published' % (after.number, after.outcome.plan_id,
-                                       self._into_stop()))
+                                       time.monotonic() - (self._stop_began or 0.0)))
                 elif after.outcome.ok:
                     self._publish_after_reply(after)
 

@@ -461,8 +461,8 @@ def plan_reference(msg: Plan) -> Reference:
 
     Raises ValueError, naming the plan and the robot, unless the message is a
     plan: one path per robot, the robots' names unique ROS names (each names
-    its topics), every position finite, and one clock: the same stamps on every
-    path, strictly increasing.
+    its topics), every pose (position and orientation) finite, and one clock:
+    the same stamps on every path, strictly increasing.
     """
     if len(msg.robot_names) != len(msg.paths):
         raise ValueError('plan %d has %d robot_names and %d paths, one per robot'

@@ -24,12 +24,16 @@ from typing import Generic
 from typing import Iterable
 from typing import TypeVar
 
+import numpy as np
 from rcl_interfaces.msg import FloatingPointRange
 from rcl_interfaces.msg import IntegerRange
 from rcl_interfaces.msg import ParameterDescriptor
 from rcl_interfaces.msg import ParameterType
 from rcl_interfaces.msg import SetParametersResult
 import yaml
+
+from ..core.limits import length_range
+from ..core.limits import lengths_in_range
 
 _KINDS = {
     'string': ParameterType.PARAMETER_STRING,
@@ -170,10 +174,13 @@ def triples(name: str, value: tuple) -> None:
                          % (name, len(value)))
 
 
-def non_negative(name: str, value: tuple) -> None:
-    """Refuse a list with a negative value."""
-    if any(item < 0 for item in value):
-        raise ValueError('%s values must be >= 0, got %r' % (name, list(value)))
+def lengths(name: str, value: float | tuple) -> None:
+    """Refuse a length the core cannot take (core.limits): each 0 or a supported length."""
+    values = list(value) if isinstance(value, tuple) else [value]
+    bad = [item for item in values if not lengths_in_range(np.array(item), zero=True)]
+    if bad:
+        raise ValueError('%s: every value must be %s, got %r'
+                         % (name, length_range(zero=True), bad[0]))
 
 
 def ros_names(name: str, value: tuple) -> None:
@@ -211,12 +218,13 @@ ROBOT_RADIUS = Spec(
     'robot_radius', 'double', 0.0,
     'Radius R of every robot (m): robots are discs (balls for dimension 3) and the gap of '
     'two robots is their centre distance - 2R; planner_node refuses overlapping bodies, '
-    'and its min_gap and required_clearance are surface gaps.', low=0.0, high=1e6)
+    'and its min_gap and required_clearance are surface gaps.', low=0.0, high=1e6,
+    check=lengths)
 OBSTACLE_RADIUS = Spec(
     'obstacle_radius', 'double_array', [],
     'Radius rho of the obstacles (m): empty for 0, one value for all, or one per obstacle '
     'in obstacle order; a robot-obstacle gap is centre distance - R - rho.',
-    check=non_negative, prose='empty, one value or one per obstacle; finite, >= 0')
+    check=lengths, prose='empty, one value or one per obstacle; each 0 or in [1e-100, 1e15]')
 
 
 # ---------------------------------------------------------------- tables

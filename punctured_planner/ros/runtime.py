@@ -208,7 +208,7 @@ class NodeGroup:
     returns a Future (or None) that the thread spins on for, such as a goal's
     result going out. ``before_teardown`` runs once the executors stopped and
     before any node is destroyed: publishers still work, no callback runs any more.
-    ``refusals`` maps a service's name to ``refuse(request, response)``, which
+    ``refusals`` maps a service's resolved name to ``refuse(request, response)``, which
     fills the reply of a request that waits past STOP_PLANNING_SEC into the
     stop: a quick answer instead of the service's own work (other services,
     such as the parameter services, run their callback). ``on_stop(began)``
@@ -222,6 +222,11 @@ class NodeGroup:
     before_teardown: Optional[Callable[[], None]] = None
     refusals: Mapping[str, Callable[[Any, Any], Any]] = field(default_factory=dict)
     on_stop: Optional[Callable[[float], None]] = None
+
+
+def past_planning_budget(began: Optional[float]) -> bool:
+    """Return whether a stop that began at ``began`` (time.monotonic()) is past its budget."""
+    return began is not None and time.monotonic() - began > STOP_PLANNING_SEC
 
 
 class ExecutorThreads:
@@ -247,7 +252,7 @@ class ExecutorThreads:
         self._refusals = dict(refusals or {})
         self._on_stop = on_stop
         self._stopping = threading.Event()
-        self._stop_began = 0.0  # time.monotonic() of the stop signal
+        self._stop_began: Optional[float] = None  # time.monotonic() of the stop signal
         self._last_reply: Optional[float] = None  # time.monotonic() after the last reply
         # Who the linger waits for: the services that replied (name -> their node), and
         # whether an action server replied (its clients are not counted: it waits the
@@ -329,8 +334,8 @@ class ExecutorThreads:
                 if header is None:
                     break
                 response = srv_type.Response()
-                refuse = self._refusals.get(service.srv_name)
-                if refuse is not None and time.monotonic() - self._stop_began > STOP_PLANNING_SEC:
+                refuse = self._refusals.get(service.service_name)
+                if refuse is not None and past_planning_budget(self._stop_began):
                     response = refuse(request, response)
                 else:
                     response = service.callback(request, response)
@@ -368,7 +373,7 @@ class ExecutorThreads:
         Return False (and shut nothing down) if a thread is still running after
         ``timeout_sec``; :meth:`stuck` names its node.
         """
-        if not self._stopping.is_set():
+        if self._stop_began is None:
             self._stop_began = time.monotonic()
             if self._on_stop is not None:
                 self._on_stop(self._stop_began)

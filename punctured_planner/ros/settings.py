@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .parameters import FRAME_ID
+from .parameters import lengths
 from .parameters import OBSTACLE_RADIUS
 from .parameters import OBSTACLES
 from .parameters import ROBOT_RADIUS
@@ -85,7 +86,7 @@ class PlannerSettings:
     required_clearance: float = Spec(
         'required_clearance', 'double', 0.0,
         'Refuse a plan whose certified minimum clearance is below this (m); 0 accepts '
-        'every collision-free plan.', low=0.0, high=1e6).field()
+        'every collision-free plan.', low=0.0, high=1e6, check=lengths).field()
     workspace_bounds: tuple = Spec(
         'workspace_bounds', 'double_array', [],
         'Walls of the workspace (m), in frame_id: [x_min, x_max, y_min, y_max] for '
