@@ -112,20 +112,6 @@ class PlanWait:
             self.heard.set_result(True)
 
 
-def all_done(futures: list[Future]) -> Future:
-    """Return a Future that is done once every one of futures is."""
-    every = Future()
-
-    def check(_: Future) -> None:
-        if all(future.done() for future in futures) and not every.done():
-            every.set_result(True)
-
-    for future in futures:
-        future.add_done_callback(check)
-    check(every)
-    return every
-
-
 @dataclass(frozen=True)
 class RobotLink:
     """One robot's topics: its odometry subscription, command and reference publishers."""
@@ -150,9 +136,10 @@ class PlanExecutor(Node):
         self._newest: ServerGoalHandle | None = None  # the goal that came last
         self._stopping = False  # the process is stopping: no new goal
         self._halted: Run | None = None  # the goal ended by the stop
-        # Every accepted goal by its id, until its result is out: done then (end_goals waits
-        # for it). Goal handles compare by value and are not hashable.
-        self._results: dict[bytes, Future] = {}
+        # The ids of the accepted goals whose result is not out yet (goal handles compare by
+        # value and are not hashable), and, once a stop began, the Future done when none is.
+        self._unfinished: set[bytes] = set()
+        self._all_out: Future | None = None
         self.create_subscription(Plan, 'plan', self._on_plan, LATCHED)
         self._server = ActionServer(self, ExecutePlan, 'execute_plan', self._execute,
                                     goal_callback=self._on_goal,
@@ -209,7 +196,7 @@ class PlanExecutor(Node):
 
     def _on_accepted(self, goal: ServerGoalHandle) -> None:
         """Note an accepted goal until its result is out, then execute it."""
-        self._results[bytes(goal.goal_id.uuid)] = Future()
+        self._unfinished.add(bytes(goal.goal_id.uuid))
         goal.execute()
 
     def _on_cancel(self, goal: ServerGoalHandle) -> CancelResponse:
@@ -229,15 +216,18 @@ class PlanExecutor(Node):
             return await self._goal_result(goal)
         finally:
             # The action server sends the result as this coroutine returns, in the same step.
-            self._results.pop(bytes(goal.goal_id.uuid), Future()).set_result(True)
+            self._unfinished.discard(bytes(goal.goal_id.uuid))
+            if self._all_out is not None and not self._unfinished:
+                self._all_out.set_result(True)
 
     async def _goal_result(self, goal: ServerGoalHandle) -> ExecutePlan.Result:
         """Return a goal's result, its goal handle ended (succeed, canceled or abort)."""
-        if goal.is_cancel_requested or self._stopping:  # before it started
-            return self._ended(goal, Lookup(None, Result.CANCELED, 'canceled before it started')
-                               if goal.is_cancel_requested else Lookup(
-                                   None, Result.STOPPED, 'plan_executor stopped before the '
-                                   'goal started'))
+        # A cancel or a stop that came before the goal started.
+        if goal.is_cancel_requested:
+            return self._ended(goal, Lookup(None, Result.CANCELED, 'canceled before it started'))
+        if self._stopping:
+            return self._ended(goal, Lookup(None, Result.STOPPED,
+                                            'plan_executor stopped before the goal started'))
         previous = self._run
         if previous is not None:
             self._end(previous, Result.PREEMPTED, 'preempted by a newer goal')
@@ -482,8 +472,10 @@ class PlanExecutor(Node):
             self._end(run, Result.STOPPED, 'plan_executor stopped at plan time %.3f s; its '
                       'robots were sent zero velocity'
                       % (run.execution.plan_time if run.execution else 0.0))
-        pending = [ended for ended in self._results.values() if not ended.done()]
-        return all_done(pending) if pending else None
+        if not self._unfinished:
+            return None
+        self._all_out = Future()
+        return self._all_out
 
     def stop_halted_robots(self) -> None:
         """Send zero velocity again to the robots end_goals stopped: the last command they get."""
