@@ -78,7 +78,7 @@ class InProcessPlanner:
                               parameter_overrides=overrides)
         self.node = group.nodes[0]
         self.threads = ExecutorThreads(group.nodes, context=self.context,
-                                       refusals=group.refusals, on_stop=group.on_stop)
+                                       on_stop=group.on_stop)
         self.threads.start()
 
     def name(self, relative):

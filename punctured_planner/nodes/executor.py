@@ -235,10 +235,8 @@ class PlanExecutor(Node):
         for waiting in self._waits:  # superseded: they end PREEMPTED (_waited)
             waiting.wake()
         found = self._plans.lookup(goal.request.plan_id, self.resolve_topic_name('plan'))
-        wait = None
         if found.code == Result.NO_PLAN:
-            wait = PlanWait(goal.request.plan_id, goal)
-            found = await self._wait_for_plan(wait)
+            found = await self._wait_for_plan(PlanWait(goal.request.plan_id, goal))
         if found.runnable is not None:
             found = self._check_per_robot(found.runnable)
         if found.runnable is None:

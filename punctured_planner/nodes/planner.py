@@ -119,7 +119,6 @@ class PlannerNode(Node):
                                                self._check_obstacles_fit)
         self._settings: PlannerSettings = self._node_parameters.settings
         self._obstacles = self._parameter_obstacles(self._settings)
-        self._check_obstacles_fit(self._settings, {'obstacles'})
 
         # The service's, the subscriptions' and the publishers' own nodes: each spun
         # apart, and apart from the parameter services (module docstring).
@@ -279,27 +278,20 @@ class PlannerNode(Node):
         """Take the stop's start (NodeGroup.on_stop): past the budget, only replies go out."""
         self._stop_began = began
 
-    @property
-    def plan_service_name(self) -> str:
-        """Return the plan_sequence service's resolved name."""
-        return self._service.service_name
-
-    def refuse_waiting(self, request: PlanSequence.Request,
-                       response: PlanSequence.Response) -> PlanSequence.Response:
+    def _refuse_late(self, number: int, request: PlanSequence.Request,
+                     response: PlanSequence.Response) -> PlanSequence.Response:
         """
-        Answer a request that waited too long into the stop, unplanned (NodeGroup.refusals).
+        Answer request #number unplanned: it was taken STOP_PLANNING_SEC into a stop.
 
-        A request taken STOP_PLANNING_SEC after the stop signal gets NODE_STOPPING
-        at once, so that the stop still answers every caller within its timeout.
+        It gets NODE_STOPPING at once, so that the stop still answers every caller
+        that reached the node before it within its timeout (doc/design.md section 16).
         """
-        self._request_count += 1
-        self._answering = self._request_count
         message = ('%s stopping: request #%d (%d configurations) reached it before the '
                    'stop signal but waited more than %.0f s into the stop, so it was not '
                    'planned; send it again to a running node'
-                   % (self.get_name(), self._answering, len(request.configurations),
+                   % (self.get_name(), number, len(request.configurations),
                       STOP_PLANNING_SEC))
-        self.get_logger().warning('plan_sequence #%d: %s' % (self._answering, message))
+        self.get_logger().warning('plan_sequence #%d: %s' % (number, message))
         return conversions.fill_error(response, ErrorCode.NODE_STOPPING, message)
 
     def _resume_collection(self) -> None:
@@ -310,10 +302,12 @@ class PlannerNode(Node):
     def _plan_request(self, request: PlanSequence.Request,
                       response: PlanSequence.Response) -> PlanSequence.Response:
         """Plan one request against a snapshot; keep what to log and publish after the reply."""
-        now_ns = self.get_clock().now().nanoseconds
-        snapshot = self.snapshot()
         self._request_count += 1
         number = self._answering = self._request_count
+        if past_planning_budget(self._stop_began):
+            return self._refuse_late(number, request, response)
+        now_ns = self.get_clock().now().nanoseconds
+        snapshot = self.snapshot()
         logger = self.get_logger()
         logger.info('plan_sequence #%d: %d configurations%s; snapshot: %s'
                     % (number, len(request.configurations),
@@ -454,9 +448,7 @@ class PlannerNode(Node):
 def planner_nodes(context: Context | None = None, **kwargs: Any) -> NodeGroup:
     """Return the PlannerNode and its server, inputs and outputs nodes: each in its own thread."""
     node = PlannerNode(context=context, **kwargs)
-    return NodeGroup([node, node.server, node.inputs, node.outputs],
-                     refusals={node.plan_service_name: node.refuse_waiting},
-                     on_stop=node.note_stop)
+    return NodeGroup([node, node.server, node.inputs, node.outputs], on_stop=node.note_stop)
 
 
 def main(args: list[str] | None = None) -> int:

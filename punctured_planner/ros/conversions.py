@@ -476,8 +476,8 @@ def plan_reference(msg: Plan) -> Reference:
         if not np.array_equal(robot_stamps, stamps[0]):
             raise ValueError('plan %d: the path of %s does not have the stamps of %s'
                              % (msg.plan_id, name, msg.robot_names[0]))
-        bad = np.flatnonzero(~np.isfinite(np.hstack([positions, orientations])).all(axis=1))
-        if bad.size:
+        bad = first_non_finite(np.hstack([positions, orientations]))
+        if bad is not None:
             raise ValueError('plan %d: the path of %s has a non-finite pose (pose %d)'
                              % (msg.plan_id, name, bad[0]))
     back = np.flatnonzero(np.diff(stamps[0]) <= 0)

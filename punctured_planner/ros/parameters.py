@@ -176,11 +176,11 @@ def triples(name: str, value: tuple) -> None:
 
 def lengths(name: str, value: float | tuple) -> None:
     """Refuse a length the core cannot take (core.limits): each 0 or a supported length."""
-    values = list(value) if isinstance(value, tuple) else [value]
-    bad = [item for item in values if not lengths_in_range(np.array(item), zero=True)]
-    if bad:
+    values = np.atleast_1d(np.asarray(value, dtype=float))
+    bad = np.flatnonzero(~lengths_in_range(values, zero=True))
+    if bad.size:
         raise ValueError('%s: every value must be %s, got %r'
-                         % (name, length_range(zero=True), bad[0]))
+                         % (name, length_range(zero=True), float(values[bad[0]])))
 
 
 def ros_names(name: str, value: tuple) -> None:
@@ -296,6 +296,8 @@ class NodeParameters(Generic[S]):
         for spec in table.specs:
             node.declare_parameter(spec.name, spec.default, spec.descriptor())
         self.settings: S = table.settings(self.values())
+        if check is not None:
+            check(self.settings, set(table.by_name))
         node.add_on_set_parameters_callback(self._on_set)
         node.add_post_set_parameters_callback(self._after_set)
 

@@ -54,8 +54,9 @@ threads leave their loop after the callback in flight, and the group's
 ``before_stop`` hook (run in the first node's thread) makes its node refuse
 goals; (2) what is in flight finishes: the plan call in flight writes its
 reply, each thread answers the service requests that had already arrived
-(within ``STOP_PLANNING_SEC`` of the signal as the service would, later with
-the group's quick refusal, ``NodeGroup.refusals``), and the hook ends the goal
+(within ``STOP_PLANNING_SEC`` of the signal as the service would, later
+quickly refused by the node, told of the stop by ``NodeGroup.on_stop``), and
+the hook ends the goal
 in flight while its thread spins on until the Future it returned is done (the
 result sent), at most ``STOP_DRAIN_SEC``, and ``REQUEST_GRACE_SEC`` more for a
 result request still on the wire;
@@ -74,7 +75,6 @@ thread still uses.
 """
 
 from dataclasses import dataclass
-from dataclasses import field
 import os
 import signal
 import sys
@@ -85,7 +85,6 @@ from typing import Any
 from typing import Callable
 from typing import Dict
 from typing import List
-from typing import Mapping
 from typing import Optional
 from typing import Sequence
 
@@ -112,8 +111,8 @@ STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 # machine and more than 30 s at a load of 2 on 2 cores (doc/design.md section 16).
 STOP_TIMEOUT_SEC = 60.0
 # Seconds after the stop signal within which a node still does all its work: a request
-# that waits is planned (later, the group's quick refusal, NodeGroup.refusals), an
-# answered plan published (later, only the reply goes out, NodeGroup.on_stop). Five such
+# that waits is planned (later, refused at once), an answered plan published (later, only
+# the reply goes out): past_planning_budget, the node told by NodeGroup.on_stop. Five such
 # requests waiting made the stop overrun 30 s, exit 1 and lose three replies.
 STOP_PLANNING_SEC = 10.0
 # Seconds the participant stays after the last reply it wrote (step 3 of the stop),
@@ -208,19 +207,15 @@ class NodeGroup:
     returns a Future (or None) that the thread spins on for, such as a goal's
     result going out. ``before_teardown`` runs once the executors stopped and
     before any node is destroyed: publishers still work, no callback runs any more.
-    ``refusals`` maps a service's resolved name to ``refuse(request, response)``, which
-    fills the reply of a request that waits past STOP_PLANNING_SEC into the
-    stop: a quick answer instead of the service's own work (other services,
-    such as the parameter services, run their callback). ``on_stop(began)``
-    runs in the signal's thread as the stop begins, with its time.monotonic():
-    a callback in flight may then cut short what only matters while the node
-    runs.
+    ``on_stop(began)`` runs in the signal's thread as the stop begins, with its
+    time.monotonic(): a node may then cut short what only matters while it runs
+    (past_planning_budget), in the callback in flight and in those of the requests
+    answered after it (the planner refuses them, NODE_STOPPING).
     """
 
     nodes: Sequence[Node]
     before_stop: Optional[Callable[[], Optional[Future]]] = None
     before_teardown: Optional[Callable[[], None]] = None
-    refusals: Mapping[str, Callable[[Any, Any], Any]] = field(default_factory=dict)
     on_stop: Optional[Callable[[float], None]] = None
 
 
@@ -235,21 +230,19 @@ class ExecutorThreads:
 
     ``start()`` once, then ``close()`` (or ``stop()`` and destroy the nodes
     yourself). ``on_failure`` is called from the thread of a callback that
-    raised; the exception is in :attr:`failure` and the logs. ``before_stop``,
-    ``refusals`` and ``on_stop`` are the NodeGroup's.
+    raised; the exception is in :attr:`failure` and the logs. ``before_stop``
+    and ``on_stop`` are the NodeGroup's.
     """
 
     def __init__(self, nodes: Sequence[Node], context: Optional[Context] = None,
                  on_failure: Optional[Callable[[], None]] = None,
                  before_stop: Optional[Callable[[], Optional[Future]]] = None,
-                 refusals: Optional[Mapping[str, Callable[[Any, Any], Any]]] = None,
                  on_stop: Optional[Callable[[float], None]] = None):
         """Make one executor per node (in ``context``); nothing spins yet."""
         self.nodes: List[Node] = list(nodes)
         self.failure: Optional[BaseException] = None
         self._on_failure = on_failure
         self._before_stop = before_stop
-        self._refusals = dict(refusals or {})
         self._on_stop = on_stop
         self._stopping = threading.Event()
         self._stop_began: Optional[float] = None  # time.monotonic() of the stop signal
@@ -321,10 +314,10 @@ class ExecutorThreads:
 
         A request the executor had not taken yet when the signal came is in flight
         for its client too: it is taken and answered here, in this thread, as the
-        executor would (at most the server's queue depth per service); from
-        STOP_PLANNING_SEC after the signal on, with the service's quick refusal
-        where the group has one (NodeGroup.refusals), so that many large requests
-        cannot hold the stop past STOP_TIMEOUT_SEC and every one is answered.
+        executor would (at most the server's queue depth per service). A node
+        past the stop's planning budget answers them quickly (NodeGroup.on_stop),
+        so that many large requests cannot hold the stop past STOP_TIMEOUT_SEC
+        and every one is answered.
         """
         for service in node.services:
             srv_type: Any = service.srv_type  # a generated type: Request, Response
@@ -333,13 +326,7 @@ class ExecutorThreads:
                     request, header = service.handle.service_take_request(srv_type.Request)
                 if header is None:
                     break
-                response = srv_type.Response()
-                refuse = self._refusals.get(service.service_name)
-                if refuse is not None and past_planning_budget(self._stop_began):
-                    response = refuse(request, response)
-                else:
-                    response = service.callback(request, response)
-                service.send_response(response, header)
+                service.send_response(service.callback(request, srv_type.Response()), header)
                 self._replied_by(service, node)
 
     def _drain(self, node: Node, executor: SingleThreadedExecutor,
@@ -461,7 +448,7 @@ def run_nodes(name: str, make_nodes: Callable[[Context], NodeGroup],
                 return EXIT_BAD_PARAMETERS
             threads = ExecutorThreads(group.nodes, context, on_failure=signals.wake,
                                       before_stop=group.before_stop,
-                                      refusals=group.refusals, on_stop=group.on_stop)
+                                      on_stop=group.on_stop)
             threads.start()
             signals.wait()
             _teardown(threads, group, timeout_sec)

@@ -85,7 +85,7 @@ class Fleet:
         self._active = np.zeros((k, 4))
         self._active_since = np.full(k, -np.inf)
         self._rng = np.random.default_rng(settings.seed)
-        self.min_gap = float(settings.bodies.pair_gaps(self.positions)[0].min(initial=np.inf))
+        self.min_gap = self._start_gap
 
     def configure(self, settings: FleetSettings) -> None:
         """
@@ -97,7 +97,9 @@ class Fleet:
         """
         k = len(self.positions)
         self.settings = settings
-        self._touching = settings.bodies.pair_gaps(self.positions)[0] < 0
+        gaps = settings.bodies.pair_gaps(self.positions)[0]
+        self._touching = gaps < 0
+        self._start_gap = float(gaps.min(initial=np.inf))  # the gap where they stand now
         self.speed_factors = (np.ones(k) if settings.speed_factors is None
                               else np.asarray(settings.speed_factors, dtype=float))
         self.latencies = (np.zeros(k) if settings.latencies is None
