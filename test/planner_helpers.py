@@ -162,3 +162,30 @@ def core_plan(configurations=CONFIGURATIONS, obstacles=OBSTACLES, dimension=2, *
     workspace = Workspace(np.asarray(obstacles, dtype=float)[:, :dimension].reshape(
         -1, dimension), dimension=dimension, **options)
     return plan(workspace, np.asarray(configurations, dtype=float)[..., :dimension])
+
+
+def faulty_plan(fault):
+    """Return the Plan message of a request with one fault (its id 3; 'none': no fault)."""
+    from punctured_planner.cli import offline_plan
+    from punctured_planner.ros import conversions
+    from punctured_planner.ros.settings import PLANNER
+    settings = PLANNER.settings({'obstacles': [-2.0, 0.5, 0.0, 0.0, -0.5, 0.0,
+                                               2.5, 0.0, 0.0]})
+    outcome = offline_plan(make_request(max_speed=0.5), settings, now_ns=10 ** 18)
+    outcome.plan_id = 3
+    message = conversions.plan_message(outcome, settings)
+    if fault == 'paths':
+        message.paths = message.paths[:3]
+    elif fault == 'name':
+        message.robot_names = ['1bad'] + message.robot_names[1:]
+    elif fault == 'twice':
+        message.robot_names = ['robot_0'] * 4
+    elif fault == 'nan':
+        pose = message.paths[2].poses[1]
+        pose.pose.position.x = float('nan')
+    elif fault == 'back':
+        stamps = [p.header for p in message.paths[0].poses]
+        stamps[2].stamp, stamps[3].stamp = stamps[3].stamp, stamps[2].stamp
+    elif fault == 'radii':
+        message.obstacle_radii = [0.1] * 2
+    return message

@@ -386,34 +386,6 @@ def test_plan_message_round_trip_to_the_executor_reference():
         conversions.plan_reference(message)
 
 
-def _faulty_plan(fault):
-    """Return the Plan message of a request with one fault (its id 3)."""
-    from planner_helpers import make_request
-    from punctured_planner.cli import offline_plan
-    from punctured_planner.ros import conversions
-    from punctured_planner.ros.settings import PLANNER
-    settings = PLANNER.settings({'obstacles': [-2.0, 0.5, 0.0, 0.0, -0.5, 0.0,
-                                               2.5, 0.0, 0.0]})
-    outcome = offline_plan(make_request(max_speed=0.5), settings, now_ns=10 ** 18)
-    outcome.plan_id = 3
-    message = conversions.plan_message(outcome, settings)
-    if fault == 'paths':
-        message.paths = message.paths[:3]
-    elif fault == 'name':
-        message.robot_names = ['1bad'] + message.robot_names[1:]
-    elif fault == 'twice':
-        message.robot_names = ['robot_0'] * 4
-    elif fault == 'nan':
-        pose = message.paths[2].poses[1]
-        pose.pose.position.x = float('nan')
-    elif fault == 'back':
-        stamps = [p.header for p in message.paths[0].poses]
-        stamps[2].stamp, stamps[3].stamp = stamps[3].stamp, stamps[2].stamp
-    elif fault == 'radii':
-        message.obstacle_radii = [0.1] * 2
-    return message
-
-
 @pytest.mark.parametrize('fault, words', [
     ('paths', 'plan 3 has 4 robot_names and 3 paths'),
     ('name', "plan 3: robot_names: '1bad' is not a valid relative ROS name"),
@@ -430,10 +402,45 @@ def test_a_plan_message_that_is_not_a_plan_is_refused_naming_the_fault(fault, wo
     robot's odometry, a NaN pose made a goal command NaN velocities forever, stamps going
     back ended a goal at once as executed, and one path for two names an IndexError.
     """
+    from planner_helpers import faulty_plan
     from punctured_planner.ros import conversions
     with pytest.raises(ValueError) as refused:
-        conversions.known_plan(_faulty_plan(fault))
+        conversions.known_plan(faulty_plan(fault))
     assert words in str(refused.value), str(refused.value)
+
+
+def test_a_goal_for_an_ignored_plan_gets_the_reason_never_an_older_plan():
+    """
+    plan_executor's store: a message that is no plan is no plan under its id, nor the latest.
+
+    Before, a goal for an ignored plan waited 5 s and ended "not there" (the reason only in
+    the executor's log), and a goal for the latest plan (0) ran the plan before it.
+    """
+    from planner_helpers import faulty_plan
+    from punctured_planner.ros import conversions
+    from punctured_planner.ros.goals import PlanStore
+    from punctured_planner.ros.goals import Result
+    store = PlanStore()
+    assert not store.heard(0) and store.lookup(0, 'plan').code == Result.NO_PLAN
+    store.add(conversions.known_plan(faulty_plan('none')))
+    message = faulty_plan('nan')
+    message.plan_id = 4
+    with pytest.raises(ValueError) as refused:
+        conversions.known_plan(message)
+    store.ignore(4, str(refused.value))
+    assert store.heard(0) and store.heard(3) and store.heard(4) and not store.heard(5)
+    latest, named = store.lookup(0, '/ns/plan'), store.lookup(4, '/ns/plan')
+    assert latest.code == named.code == Result.NO_PLAN and latest.plan is None
+    assert latest.message.startswith('the latest, plan 4 on /ns/plan was ignored: plan 4: '
+                                     'the path of robot_2 has a non-finite pose'), latest
+    assert named.message.startswith('plan 4 on /ns/plan was ignored'), named
+    assert store.lookup(3, 'plan').runnable.plan_id == 3
+    store.ignore(3, 'robot_names must be unique')  # heard again, and no plan now
+    assert store.lookup(3, 'plan').runnable is None
+    newer = faulty_plan('none')
+    newer.plan_id = 5
+    store.add(conversions.known_plan(newer))
+    assert store.lookup(0, 'plan').runnable.plan_id == 5
 
 
 def test_plan_message_carries_the_acceleration_limit_to_the_executor():

@@ -403,3 +403,56 @@ def test_a_goal_waiting_for_its_plan_ends_stopped_at_a_stop(ros_client, ros_env,
     finally:
         action.destroy()
         executor.stop()
+
+
+def test_a_goal_for_a_plan_that_is_no_plan_ends_at_once_saying_why(
+        ros_client, ros_env, tmp_path):
+    """
+    A goal waiting for plan 7 ends NO_PLAN as soon as plan 7 arrives malformed, with why.
+
+    Before, it waited PLAN_WAIT_SEC and ended "plan 7 is not there" (the reason was only in
+    the executor's log), and a goal for the latest plan ran an older one.
+    """
+    import os
+
+    from planner_helpers import faulty_plan
+    from punctured_planner.nodes.executor import PLAN_WAIT_SEC
+    from punctured_planner.ros.qos import LATCHED
+    from punctured_planner_interfaces.action import ExecutePlan
+    from punctured_planner_interfaces.msg import Plan
+    from rclpy.action import ActionClient
+    namespace = '/pp_exec_faulty_%d' % os.getpid()
+    executor = NodeProcess([venv_script('plan_executor'), '--ros-args', '-r',
+                            '__ns:=' + namespace], ros_env,
+                           str(tmp_path / 'plan_executor.log'), namespace)
+    action = ActionClient(ros_client.node, ExecutePlan, namespace + '/execute_plan')
+    publisher = ros_client.node.create_publisher(Plan, namespace + '/plan', LATCHED)
+    try:
+        assert action.wait_for_server(timeout_sec=30), executor.log()
+        sent = action.send_goal_async(ExecutePlan.Goal(plan_id=7))
+        assert ros_client.spin_until(sent.done, 10) and sent.result().accepted
+        ros_client.spin_until(lambda: False, 0.3)
+        message = faulty_plan('nan')
+        message.plan_id = 7
+        published = time.monotonic()
+        publisher.publish(message)
+        result = sent.result().get_result_async()
+        assert ros_client.spin_until(result.done, 10), executor.log()
+        waited = time.monotonic() - published
+        ended = result.result().result
+        assert ended.error_code == ExecutePlan.Result.NO_PLAN, ended
+        assert waited < PLAN_WAIT_SEC, (waited, ended.error_msg)
+        assert ended.error_msg.startswith(
+            'plan 7 on %s/plan was ignored: plan 7: the path of robot_2 has a non-finite '
+            'pose' % namespace), ended.error_msg
+        latest = action.send_goal_async(ExecutePlan.Goal(plan_id=0))
+        assert ros_client.spin_until(latest.done, 10) and latest.result().accepted
+        result = latest.result().get_result_async()
+        assert ros_client.spin_until(result.done, 10), executor.log()
+        assert result.result().result.error_msg.startswith('the latest, plan 7 on'), \
+            result.result().result
+        assert 'Traceback' not in executor.log(), executor.log()
+    finally:
+        ros_client.node.destroy_publisher(publisher)
+        action.destroy()
+        executor.stop()

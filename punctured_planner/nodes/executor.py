@@ -13,7 +13,8 @@ linear.x and angular.z, linear.y exactly 0) and ``<robot>/reference_pose``
 
 Goal life: the plan is looked up (``NO_PLAN`` once ``PLAN_WAIT_SEC`` passed
 without it: the planner answers before it publishes, so a goal may name a plan
-still on its way), its tolerance checked (``UNSAFE_PLAN``), ``drive``,
+still on its way; at once, with the reason, if the message was no plan), its
+tolerance checked (``UNSAFE_PLAN``), ``drive``,
 ``max_speeds`` and ``max_accelerations`` checked against its robots
 (``UNKNOWN_ROBOTS``: neither one value nor one per robot);
 the executor then waits up to ``discovery_timeout`` for
@@ -158,21 +159,32 @@ class PlanExecutor(Node):
     # ------------------------------------------------------------ inputs
 
     def _on_plan(self, msg: Plan) -> None:
-        """Keep a published plan (the last PLAN_HISTORY); subscribe to its robots' odometry."""
+        """
+        Keep a published plan (the last PLAN_HISTORY); subscribe to its robots' odometry.
+
+        A message that is not a plan is kept as ignored, with the reason, for the goals
+        that name it (or the latest plan): they end NO_PLAN saying why.
+        """
         try:
             plan = conversions.known_plan(msg)
         except ValueError as error:
             self.get_logger().error('plan %d ignored: %s' % (msg.plan_id, error))
+            self._plans.ignore(msg.plan_id, str(error))
+            self._wake_waits(msg.plan_id)
             return
         self._plans.add(plan)
-        for wait in self._waits:
-            if wait.plan_id in (0, plan.plan_id):
-                wait.wake()
+        self._wake_waits(plan.plan_id)
         for name in plan.names:
             self._link(name)
         self.get_logger().info('plan %d: %d robots, %.3f s, min gap %.6g m, tolerance %.6g m'
                                % (plan.plan_id, len(plan.names), plan.reference.duration,
                                   plan.min_gap, plan.tolerance))
+
+    def _wake_waits(self, plan_id: int) -> None:
+        """End the waits of the goals for plan_id or for the latest plan: it was heard."""
+        for wait in self._waits:
+            if wait.plan_id in (0, plan_id):
+                wait.wake()
 
     def _link(self, name: str) -> None:
         """Create the odometry subscription and command publishers of a robot (once)."""
@@ -235,7 +247,7 @@ class PlanExecutor(Node):
         for waiting in self._waits:  # superseded: they end PREEMPTED (_waited)
             waiting.wake()
         found = self._plans.lookup(goal.request.plan_id, self.resolve_topic_name('plan'))
-        if found.code == Result.NO_PLAN:
+        if not self._plans.heard(goal.request.plan_id):  # it may be on its way
             found = await self._wait_for_plan(PlanWait(goal.request.plan_id, goal))
         if found.runnable is not None:
             found = self._check_per_robot(found.runnable)

@@ -2,7 +2,8 @@
 What plan_executor keeps between callbacks: the plans it heard, and the robots' state.
 
 ROS-free apart from the ExecutePlan result codes: :class:`PlanStore` keeps the
-last published plans and answers a goal's plan id with a :class:`Lookup`;
+last published plans (and why the messages that were no plan were ignored) and
+answers a goal's plan id with a :class:`Lookup`;
 :func:`fleet_state` turns the robots' last odometry into one control step's
 input (:class:`FleetState`).
 """
@@ -50,35 +51,62 @@ class Lookup:
 
 
 class PlanStore:
-    """The last PLAN_HISTORY plans by id, oldest first."""
+    """
+    The last PLAN_HISTORY plans by id, oldest first, and the last ignored plan messages.
+
+    A message on ``plan`` that is not a plan is ignored, and its id remembered with the
+    reason: a goal naming it, or naming the latest plan (0) while it is the latest heard,
+    ends NO_PLAN with that reason at once, never running an older plan in its place.
+    """
 
     def __init__(self) -> None:
         """Start with no plan."""
         self._plans: OrderedDict[int, KnownPlan] = OrderedDict()
+        self._ignored: OrderedDict[int, str] = OrderedDict()  # plan id: why
+        self._latest: int | None = None  # the id last heard, a plan or not
 
     def add(self, plan: KnownPlan) -> None:
         """Keep a plan (a plan id heard again replaces the old one and becomes the latest)."""
-        self._plans.pop(plan.plan_id, None)
-        self._plans[plan.plan_id] = plan
-        while len(self._plans) > PLAN_HISTORY:
-            self._plans.popitem(last=False)
+        _keep(self._plans, plan.plan_id, plan)
+        self._ignored.pop(plan.plan_id, None)
+        self._latest = plan.plan_id
+
+    def ignore(self, plan_id: int, reason: str) -> None:
+        """Note a message that is not a plan: its id is no plan now, and the latest heard."""
+        _keep(self._ignored, plan_id, reason)
+        self._plans.pop(plan_id, None)
+        self._latest = plan_id
+
+    def heard(self, plan_id: int) -> bool:
+        """Return whether a message named plan_id (0: any) is kept, a plan or an ignored one."""
+        named = self._latest if plan_id == 0 else plan_id
+        return named in self._plans or named in self._ignored
 
     def lookup(self, plan_id: int, topic: str) -> Lookup:
         """Return the plan a goal names (0: the latest) with NONE, NO_PLAN or UNSAFE_PLAN."""
-        if not self._plans:
+        named = self._latest if plan_id == 0 else plan_id
+        if named is None:
             return Lookup(None, Result.NO_PLAN, 'no plan received yet on %s' % topic)
-        if plan_id == 0:
-            plan = next(reversed(self._plans.values()))
-        elif plan_id in self._plans:
-            plan = self._plans[plan_id]
-        else:
+        if named in self._ignored:
+            return Lookup(None, Result.NO_PLAN, '%splan %d on %s was ignored: %s' % (
+                'the latest, ' if plan_id == 0 else '', named, topic, self._ignored[named]))
+        if named not in self._plans:
             return Lookup(None, Result.NO_PLAN, 'plan %d is not there (known plans: %s)' % (
-                plan_id, ', '.join(str(i) for i in self._plans)))
+                named, ', '.join(str(i) for i in self._plans)))
+        plan = self._plans[named]
         if not plan.tolerance > 0:
             return Lookup(plan, Result.UNSAFE_PLAN, (
                 'plan %d has min_gap %.6g m, tracking tolerance %.6g m: its bodies touch '
                 'even when executed exactly' % (plan.plan_id, plan.min_gap, plan.tolerance)))
         return Lookup(plan, Result.NONE)
+
+
+def _keep(history: OrderedDict, plan_id: int, value: object) -> None:
+    """Make plan_id the newest entry of history, dropping the oldest beyond PLAN_HISTORY."""
+    history.pop(plan_id, None)
+    history[plan_id] = value
+    while len(history) > PLAN_HISTORY:
+        history.popitem(last=False)
 
 
 @dataclass(frozen=True, eq=False)
