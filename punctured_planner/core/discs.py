@@ -439,9 +439,20 @@ def staging_slots(p: np.ndarray, rank: np.ndarray, layout: DiscLayout) -> np.nda
     centre = float(p.mean())
     room = layout.walls
     if room is not None:
-        centre = (0.5 * (room.low + room.high) if room.high - room.low < 2.0 * half
-                  else float(np.clip(centre, room.low + half, room.high - half)))
+        centre = _clip_or_middle(centre, room.low + half, room.high - half)
     return centre + (rank - (len(rank) - 1) / 2) * layout.pitch
+
+
+def _clip_or_middle(value: float, low: float, high: float) -> float:
+    """
+    Return value clipped into [low, high], or the middle of the two when high < low.
+
+    The walls' rule for where the staging line and the lanes go: low and high are
+    fixed per workspace and count (of robots, of lanes), so the result is
+    continuous in value, and where the line or the lanes are longer than the room
+    allows they are centred in it.
+    """
+    return 0.5 * (low + high) if high < low else float(np.clip(value, low, high))
 
 
 def shared_lanes(first: np.ndarray, second: np.ndarray) -> np.ndarray:
@@ -558,9 +569,7 @@ def staging_height(layout: DiscLayout, offsets: np.ndarray, top_lane: int) -> fl
     room = layout.walls
     if room is None:
         return height
-    highest = room.ceiling - top_lane * layout.pitch
-    return (0.5 * (room.floor + highest) if highest < room.floor
-            else float(np.clip(height, room.floor, highest)))
+    return _clip_or_middle(height, room.floor, room.ceiling - top_lane * layout.pitch)
 
 
 def section(configurations: np.ndarray, layout: DiscLayout) -> DiscSection:
