@@ -187,6 +187,7 @@ def reset_obstacles(node: 'Node', executor: 'Executor', planner_node: str,
     a set that came on the ``obstacles`` topic (one that outlived its publisher).
     """
     from rclpy.parameter import Parameter
+    from rclpy.parameter import parameter_value_to_python
     from rclpy.parameter_client import AsyncParameterClient
 
     remote = AsyncParameterClient(node, planner_node)
@@ -202,7 +203,11 @@ def reset_obstacles(node: 'Node', executor: 'Executor', planner_node: str,
     got = wait(remote.get_parameters(['obstacles']))
     if got is None or not got.values:
         return 'no obstacles parameter on %s' % planner_node
-    values = list(got.values[0].double_array_value)
+    current = parameter_value_to_python(got.values[0])
+    try:  # integers too: the parameter is dynamically typed (obstacles: [0, 1, 0])
+        values = [float(v) for v in current]
+    except (TypeError, ValueError):
+        return 'obstacles on %s is %r, not a list of numbers' % (planner_node, current)
     done = wait(remote.set_parameters(
         [Parameter('obstacles', Parameter.Type.DOUBLE_ARRAY, values)]))
     if done is None or not done.results[0].successful:
@@ -248,19 +253,24 @@ def offline_plan(request: Any, settings: 'PlannerSettings',
     Answer a PlanSequence request without a ROS graph; return the planning Outcome.
 
     The obstacles come from the ``obstacles`` parameter; there is no robot
-    state, so ``use_current_state`` gets NO_ROBOT_STATE.
+    state, so ``use_current_state`` gets NO_ROBOT_STATE. Raise ValueError, as
+    planner_node exits 2 at start-up, if the parameters cannot plan among them.
     """
     from punctured_planner.ros import conversions
     from punctured_planner.ros.planning import PlanSequenceHandler
+    from punctured_planner.ros.settings import PLANNER
     from punctured_planner.ros.snapshot import ObstacleSet
     from punctured_planner.ros.snapshot import Snapshot
     from punctured_planner_interfaces.srv import PlanSequence
 
+    handler = PlanSequenceHandler()
+    obstacles = ObstacleSet(conversions.obstacles_from_parameter(settings.obstacles))
+    handler.check_parameter_obstacles(settings, obstacles, set(PLANNER.by_name))
     snapshot = Snapshot(
-        settings, ObstacleSet(conversions.obstacles_from_parameter(settings.obstacles)),
+        settings, obstacles,
         state=None, state_problem='punctured-planner plan has no robot state (no ROS graph)')
     now_ns = time.time_ns() if now_ns is None else now_ns
-    return PlanSequenceHandler().handle(request, PlanSequence.Response(), snapshot, now_ns)
+    return handler.handle(request, PlanSequence.Response(), snapshot, now_ns)
 
 
 def _plan(args):
@@ -278,7 +288,11 @@ def _plan(args):
     request = _request(args)
     if request is None:
         return EXIT_USAGE
-    outcome = offline_plan(request, settings)
+    try:
+        outcome = offline_plan(request, settings)
+    except ValueError as error:
+        print('punctured-planner: bad parameter file: %s' % error, file=sys.stderr)
+        return EXIT_USAGE
     if outcome.exception is not None:
         print('punctured-planner: %r' % outcome.exception, file=sys.stderr)
     code = print_response(outcome.response, args.no_paths)

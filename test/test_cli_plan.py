@@ -56,6 +56,12 @@ def test_plan_refusals_and_exit_codes(capsys, tmp_path):
     params.write_text('planner_node:\n  ros__parameters:\n    variant: fast\n', encoding='utf-8')
     code, data, err = run(capsys, 'plan', EXAMPLE, '--params', str(params))
     assert code == 2 and 'variant' in err
+    # obstacles planner_node refuses at start-up (exit 2): the plan command refuses them too
+    params.write_text('planner_node:\n  ros__parameters:\n    obstacles: [1.0, 1.0, 0.0, '
+                      '1.0, 1.0, 0.0]\n', encoding='utf-8')
+    code, data, err = run(capsys, 'plan', EXAMPLE, '--params', str(params))
+    assert code == 2 and data is None, (code, data)
+    assert 'bad parameter file: OBSTACLES_DEGENERATE with 2 obstacles' in err, err
     # parameters not a mapping; an output that cannot be written: exit 2, no traceback
     params.write_text('/**/planner_node:\n  ros__parameters: [1, 2]\n', encoding='utf-8')
     code, data, err = run(capsys, 'plan', EXAMPLE, '--params', str(params))

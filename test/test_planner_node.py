@@ -642,3 +642,25 @@ def test_a_bad_obstacle_set_is_refused_on_arrival(planner, ros_client, monkeypat
                            10.0) is None
     assert node.node.snapshot().obstacles.source == 'parameter'
     assert np.array_equal(node.node.snapshot().obstacles.points, OBSTACLES)
+
+
+def test_reset_obstacles_keeps_an_obstacles_parameter_given_as_integers(planner, ros_client):
+    """
+    punctured-planner reset-obstacles sets the parameter's own value again, integers too.
+
+    The parameter is dynamically typed, so [0, 2, 0, 3, 0, 0] is an integer array; before,
+    the command read the double array alone, set [] and reported success.
+    """
+    from punctured_planner.cli import reset_obstacles
+    from punctured_planner.ros.qos import LATCHED
+    _, pose_array_type, _, _, _, _ = _types()
+    node = planner(obstacles=[0, 2, 0, 3, 0, 0])
+    publisher = ros_client.node.create_publisher(pose_array_type, node.name('obstacles'),
+                                                 LATCHED)
+    publisher.publish(pose_array([[5.0, 5.0, 0.0]]))
+    assert ros_client.spin_until(
+        lambda: node.node.snapshot().obstacles.source.endswith('/obstacles'), 10)
+    assert reset_obstacles(ros_client.node, ros_client.executor, node.name('planner_node'),
+                           10.0) is None
+    assert node.node.snapshot().obstacles.source == 'parameter'
+    assert node.node.snapshot().obstacles.points.tolist() == [[0, 2, 0], [3, 0, 0]]

@@ -153,7 +153,13 @@ class PlanExecutor(Node):
 
     @property
     def _settings(self) -> ExecutorSettings:
-        """Return the accepted parameters: the mode holds per goal, the rest per step."""
+        """
+        Return the accepted parameters.
+
+        The mode holds for a goal's whole run, and the execution settings (gain, limits,
+        fractions, goal_tolerance, drive) from its first control step with every robot
+        heard; the timeouts (odom, hold, discovery) apply from the next step.
+        """
         return self._node_parameters.settings
 
     # ------------------------------------------------------------ inputs

@@ -176,31 +176,10 @@ class PlannerNode(Node):
             self._update_odometry_subscriptions(settings.robot_names)
 
     def _check_obstacles_fit(self, settings: PlannerSettings, changed: set[str]) -> None:
-        """
-        On-set and at start-up: refuse settings the parameter's obstacles cannot be planned in.
-
-        A new obstacles value gets the checks a set arriving on the topic gets
-        (PlanSequenceHandler.check_obstacles); a set in use from the parameter, when
-        other settings change, the core's Workspace rule (check_workspace: its
-        obstacle_radius count, obstacles beyond workspace_bounds). So plane_z or
-        frame_id may change first and the obstacles follow. A set from the topic is
-        checked when it arrives, and an empty set is not checked: per-obstacle radii
-        may wait for the topic's set.
-        """
-        new = 'obstacles' in changed
-        obstacles = self._parameter_obstacles(settings) if new else self._obstacles
-        if not (obstacles.from_parameter and len(obstacles.points)):
-            return
-        try:
-            (self._handler.check_obstacles if new
-             else self._handler.check_workspace)(settings, obstacles)
-        except PlanningError as error:
-            hint = ('; to change obstacles and obstacle_radius together, set both in one call '
-                    '(ros2 param load) or make obstacle_radius one value first'
-                    if changed & {'obstacles', 'obstacle_radius'} else '')
-            raise ValueError('%s with %s: %s%s' % (
-                error.code.name, obstacles.describe(),
-                error.describe(ObstacleNames(obstacles)), hint)) from None
+        """On-set and at start-up: refuse settings the obstacles cannot be planned in."""
+        obstacles = (self._parameter_obstacles(settings) if 'obstacles' in changed
+                     else self._obstacles)
+        self._handler.check_parameter_obstacles(settings, obstacles, changed)
 
     def _parameter_obstacles(self, settings: PlannerSettings) -> ObstacleSet:
         return ObstacleSet(conversions.obstacles_from_parameter(settings.obstacles),

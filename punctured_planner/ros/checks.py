@@ -4,7 +4,9 @@ The ROS-level checks of a PlanSequence request, in the priority order of the err
 1. NO_CONFIGURATIONS, 2. NO_ROBOT_STATE, 3. REQUEST_OVER_LIMITS (from list
 lengths, before any conversion or allocation), 4. INVALID_REQUEST,
 5. ROBOT_COUNT_MISMATCH, 6. NON_FINITE_VALUE, 7. FRAME_MISMATCH, 8. OFF_PLANE;
-the core's own checks come after (9-13). The finiteness check runs here,
+the core's own checks come after (9-13), and two of the answer's, once
+planned: REQUEST_OVER_LIMITS for the plan's own pose count and INVALID_REQUEST
+for stamps past 2038 (check_poses, check_duration). The finiteness check runs here,
 before the frame and plane checks, because its code comes first and in
 planar mode the core never sees z. Each raises a PlanningError with its
 culprits as data; :mod:`punctured_planner.ros.wording` names them.

@@ -258,7 +258,8 @@ def plan_to_paths(samples: core.Samples, orientations: npt.ArrayLike, frame_id: 
 
     orientations (n, k, 4) are the input orientations at the waypoints; start_ns
     the stamp of the first pose. samples is ``plan.sample(samples_per_leg,
-    max_speed)``: no pose twice, C_m exactly at ``samples.waypoints[m]``.
+    max_speed, max_acceleration)``: no pose twice, C_m exactly at
+    ``samples.waypoints[m]``.
     Built once, for the response and the topics alike: a :class:`Paths` of the
     messages (all paths share one Header object per stamp, and one as their own
     header, so their stamps are identical by construction, and each robot one

@@ -6,7 +6,8 @@ snapshot of its subscriptions and parameters, ``punctured-planner plan`` calls
 it offline with a parameter file. :meth:`PlanSequenceHandler.handle` runs
 named steps that return values, as nav2's computePlan: gather and check
 (:mod:`punctured_planner.ros.checks`, codes 1-8 in priority order), plan (the
-core: codes 9-13) and answer (paths and response). Every PlanningError they
+core: codes 9-13) and answer (paths and response; codes 3 and 4 where the plan
+has more poses than max_poses or stamps past 2038). Every PlanningError they
 raise is worded (:mod:`punctured_planner.ros.wording`) and becomes the
 response's error code in one place, :meth:`PlanSequenceHandler.handle`.
 """
@@ -25,6 +26,7 @@ from .settings import PlannerSettings
 from .snapshot import ObstacleSet
 from .snapshot import Outcome
 from .snapshot import Snapshot
+from .wording import ObstacleNames
 from .wording import RequestNames
 from .. import core
 from ..core import ErrorCode
@@ -116,6 +118,33 @@ class PlanSequenceHandler:
         checks.check_obstacle_plane(settings, obstacles)
         checks.check_obstacle_range(settings, obstacles)
         self.check_workspace(settings, obstacles)
+
+    def check_parameter_obstacles(self, settings: PlannerSettings, obstacles: ObstacleSet,
+                                  changed: set[str]) -> None:
+        """
+        Raise ValueError, the culprit named, if settings cannot plan among these obstacles.
+
+        For the node's on-set and start-up, and ``punctured-planner plan``'s parameter
+        file: a new obstacles value (in changed) gets the checks a set arriving on the
+        topic gets (check_obstacles); a set in use from the parameter, when other
+        settings change, the core's Workspace rule (check_workspace: its
+        obstacle_radius count, obstacles beyond workspace_bounds). So plane_z or
+        frame_id may change first and the obstacles follow. A set from the topic is
+        checked when it arrives, and an empty set is not checked: per-obstacle radii
+        may wait for the topic's set.
+        """
+        if not (obstacles.from_parameter and len(obstacles.points)):
+            return
+        try:
+            (self.check_obstacles if 'obstacles' in changed
+             else self.check_workspace)(settings, obstacles)
+        except PlanningError as error:
+            hint = ('; to change obstacles and obstacle_radius together, set both in one call '
+                    '(ros2 param load) or make obstacle_radius one value first'
+                    if changed & {'obstacles', 'obstacle_radius'} else '')
+            raise ValueError('%s with %s: %s%s' % (
+                error.code.name, obstacles.describe(),
+                error.describe(ObstacleNames(obstacles)), hint)) from None
 
     def check_workspace(self, settings: PlannerSettings, obstacles: ObstacleSet) -> None:
         """

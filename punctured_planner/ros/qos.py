@@ -35,7 +35,8 @@ LATCHED = QoSProfile(depth=1, history=HistoryPolicy.KEEP_LAST,
 STATE = QoSProfile(depth=1, history=HistoryPolicy.KEEP_LAST,
                    reliability=ReliabilityPolicy.BEST_EFFORT,
                    durability=DurabilityPolicy.VOLATILE)
-# Commands and references: a short queue, reliable (the rclpy default for a depth).
+# Commands, references and the simulator's odometry and robot_states: a short queue,
+# reliable (the rclpy default for a depth).
 COMMANDS = 10
 
 # The node: requests that may wait while it plans (one client's call each), and
