@@ -68,7 +68,8 @@ EXPECTED_EXECUTE_PLAN = {
 }
 EXECUTE_PLAN_CODES = {'NONE': 0, 'NO_PLAN': 1, 'UNKNOWN_ROBOTS': 2, 'FRAME_MISMATCH': 3,
                       'UNSAFE_PLAN': 4, 'CANCELED': 5, 'PREEMPTED': 6, 'STOPPED': 7,
-                      'ODOMETRY_LOST': 8, 'UNKNOWN': 99}
+                      'ODOMETRY_LOST': 8, 'NOT_AT_START': 9, 'CLOCK_HELD': 10,
+                      'UNKNOWN': 99}
 
 
 def _plan_sequence():

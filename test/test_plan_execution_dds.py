@@ -15,6 +15,7 @@ ending on its goal facing the requested heading. The figures for 20 robots are
 in bench/.
 """
 
+import re
 import signal
 import time
 
@@ -221,6 +222,7 @@ def started_graph(ros_client, ros_env, tmp_path, tag, parameters):
 
 
 def test_plan_to_motion_over_dds(graph):
+    from nav_msgs.msg import Odometry
     from punctured_planner_interfaces.action import ExecutePlan
     result_type = ExecutePlan.Result
     client = graph.client
@@ -259,6 +261,16 @@ def test_plan_to_motion_over_dds(graph):
     assert feedback[-1][1].plan_time == held and feedback[-1][1].clock_rate == 0.0
     graph.set_sim(muted_robots=[])
     assert client.spin_until(lambda: feedback[-1][1].plan_time > held + 0.5, 10)
+    # odometry that is no pose is ignored (warned): before, one NaN position made the clock
+    # jump to the plan's end and every robot get NaN velocities for good
+    not_a_pose = Odometry()
+    not_a_pose.header.frame_id = 'map'
+    not_a_pose.pose.pose.position.x = float('nan')
+    publisher = client.node.create_publisher(Odometry, graph.name('r1/odom'), 10)
+    for _ in range(5):
+        publisher.publish(not_a_pose)
+        client.spin_until(lambda: False, 0.04)
+    client.node.destroy_publisher(publisher)
     result = graph.result(handle)
     assert result.error_code == result_type.NONE, result.error_msg + graph.logs()
     executed = result.executed_duration.sec + result.executed_duration.nanosec * 1e-9
@@ -269,6 +281,18 @@ def test_plan_to_motion_over_dds(graph):
     assert graph.gap[-1] >= 0.0, graph.processes['fleet_sim'].log()
     client.spin_until(lambda: False, 0.3)
     assert np.linalg.norm(graph.positions() - GOAL, axis=1).max() <= 0.02
+    executor_log = graph.processes['plan_executor'].log()
+    assert 'odometry of r1 ignored: its position (nan, ' in executor_log, executor_log
+    assert all(np.isfinite([m.linear.x, m.linear.y, m.angular.z]).all()
+               for name in NAMES for _, m in graph.commands[name])
+    # the same plan again, its robots now at its end: refused, never driven back in a
+    # straight line to a start its certificate needs
+    result = graph.result(graph.send(1)[0])
+    assert result.error_code == result_type.NOT_AT_START, result.error_msg
+    named = dict(re.findall(r'(r\d) ([0-9.]+) m', result.error_msg))
+    assert sorted(named) == NAMES, result.error_msg
+    assert all(abs(float(named[name]) - np.linalg.norm(np.subtract(GOAL[i], START[i])))
+               <= 0.02 for i, name in enumerate(NAMES)), result.error_msg
 
     # a goal sent before its plan waits for it (the planner answers before it publishes),
     # then a cancel: every robot is commanded zero at once and stops
@@ -291,6 +315,20 @@ def test_plan_to_motion_over_dds(graph):
     # braking at 1 m/s^2 from at most 1 m/s
     assert client.spin_until(lambda: graph.speeds().max() < 1e-9, 1.5), graph.speeds()
     graph.set_executor(mode='velocity')
+
+    # a robot that cannot move, its odometry fresh, holds the clock: the goal ends
+    # CLOCK_HELD after hold_timeout (before, the fleet waited for it for good)
+    graph.set_sim(speed_factors=[1.0, 0.0, 1.0])
+    graph.set_executor(hold_timeout=1.0)
+    graph.plan([GOAL])
+    handle, feedback = graph.send(0)
+    result = graph.result(handle, 30)
+    assert result.error_code == result_type.CLOCK_HELD, result.error_msg + graph.logs()
+    assert 'hold_timeout 1 s' in result.error_msg and ': r1 ' in result.error_msg, \
+        result.error_msg
+    assert client.spin_until(lambda: graph.speeds().max() < 1e-9, 1.5), graph.speeds()
+    graph.set_sim(speed_factors=[0.5, 1.0, 1.0])
+    graph.set_executor(hold_timeout=5.0)
 
     # goals that wait for a plan not out yet: a cancel ends one at once, a newer goal
     # preempts one; before, the cancel was accepted and ignored (the plan, once out, ran

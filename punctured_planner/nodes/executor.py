@@ -14,17 +14,20 @@ linear.x and angular.z, linear.y exactly 0) and ``<robot>/reference_pose``
 Goal life: the plan is looked up (``NO_PLAN`` once ``PLAN_WAIT_SEC`` passed
 without it: the planner answers before it publishes, so a goal may name a plan
 still on its way; at once, with the reason, if the message was no plan), its
-tolerance checked (``UNSAFE_PLAN``), ``drive``,
-``max_speeds`` and ``max_accelerations`` checked against its robots
-(``UNKNOWN_ROBOTS``: neither one value nor one per robot);
-the executor then waits up to ``discovery_timeout`` for
-fresh odometry of every robot (``UNKNOWN_ROBOTS``) in the plan's frame
-(``FRAME_MISMATCH``); then it runs until every robot has arrived (``NONE``),
-a cancel (``CANCELED``: every robot is sent zero velocity from the cancel
-callback itself, without waiting for the next tick), a newer goal
-(``PREEMPTED``), odometry in another frame (``FRAME_MISMATCH``) or odometry
-stale for longer than ``hold_timeout`` (``ODOMETRY_LOST``: the clock held that
-long, every robot is sent zero velocity). A stale robot gets zero velocity from
+tolerance checked (``UNSAFE_PLAN``), ``drive``, ``max_speeds`` and
+``max_accelerations`` checked against its robots (``UNKNOWN_ROBOTS``: neither
+one value nor one per robot); the executor then waits up to
+``discovery_timeout`` for fresh odometry of every robot (``UNKNOWN_ROBOTS``) in
+the plan's frame (``FRAME_MISMATCH``), each within the plan's tracking
+tolerance of its start (``NOT_AT_START``: the certificate holds from there
+only); then it runs until every robot has arrived (``NONE``), a cancel
+(``CANCELED``: every robot is sent zero velocity from the cancel callback
+itself, without waiting for the next tick), a newer goal (``PREEMPTED``),
+odometry in another frame (``FRAME_MISMATCH``), odometry stale for longer than
+``hold_timeout`` (``ODOMETRY_LOST``: the clock held that long, every robot is
+sent zero velocity) or a clock held that long with every robot's odometry
+fresh (``CLOCK_HELD``: a robot that cannot follow). Odometry whose pose is not
+finite is ignored (warned). A stale robot gets zero velocity from
 the first control step that finds its odometry older than ``odom_timeout``.
 Everything runs on one single-threaded executor, so callbacks never overlap.
 A goal still waiting for its plan ends at once when canceled (``CANCELED``),
@@ -46,6 +49,7 @@ from typing import Any
 from geometry_msgs.msg import PoseStamped
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
+import numpy as np
 from punctured_planner_interfaces.action import ExecutePlan
 from punctured_planner_interfaces.msg import Plan
 from rclpy.action import ActionServer
@@ -97,6 +101,7 @@ class Run:
     last_ns: int = 0
     stale: tuple = ()
     stale_since: int | None = None  # ns: the first control step of the current hold
+    held_since: int | None = None  # ns: the first step of a hold with every robot heard
 
 
 @dataclass(eq=False)
@@ -203,8 +208,20 @@ class PlanExecutor(Node):
             self.create_publisher(PoseStamped, name + '/reference_pose', COMMANDS))
 
     def _on_odometry(self, name: str, msg: Odometry) -> None:
-        self._odometry[name] = conversions.robot_odometry(msg,
-                                                          self.get_clock().now().nanoseconds)
+        """
+        Keep a robot's latest odometry; ignore one whose pose is not finite (warned).
+
+        A NaN position made the clock jump to the plan's end and every robot get NaN
+        velocities for good; ignored, it leaves the robot's last good odometry to age
+        (stale after odom_timeout, the goal ODOMETRY_LOST after hold_timeout).
+        """
+        odometry = conversions.robot_odometry(msg, self.get_clock().now().nanoseconds)
+        problem = odometry.problem()
+        if problem:
+            self.get_logger().warning('odometry of %s ignored: %s' % (name, problem),
+                                      throttle_duration_sec=1.0)
+            return
+        self._odometry[name] = odometry
 
     # ------------------------------------------------------------ the action
 
@@ -378,6 +395,8 @@ class PlanExecutor(Node):
         step = execution.step((now - run.last_ns) * 1e-9, state.positions,
                               state.stale_mask, state.orientations, state.ages)
         run.last_ns = now
+        if self._held_too_long(run, step, state, now):
+            return
         self._log_stale(run, state, step.plan_time)
         self._publish_step(run, step, state, now)
         run.goal.publish_feedback(ExecutePlan.Feedback(
@@ -401,6 +420,16 @@ class PlanExecutor(Node):
                              '(topics %s)' % (settings.discovery_timeout, ', '.join(state.stale),
                                               ', '.join(self.resolve_topic_name(n + '/odom')
                                                         for n in state.stale)))
+            return None
+        away = np.linalg.norm(state.positions - plan.reference.position(0.0), axis=1)
+        if (away > plan.tolerance).any():
+            far = np.flatnonzero(away > plan.tolerance)
+            self._finish(run, Result.NOT_AT_START, '%s farther than the tracking tolerance '
+                         '%.6g m from the start of plan %d (%s): the plan is certified from '
+                         'its start only; plan again from where they are (use_current_state)'
+                         % ('robot' if far.size == 1 else 'robots', plan.tolerance,
+                            plan.plan_id, ', '.join('%s %.3f m' % (plan.names[i], away[i])
+                                                    for i in far)))
             return None
         execution = Execution(plan.reference, plan.tolerance, settings.execution, plan.bodies)
         run.execution = execution
@@ -428,6 +457,32 @@ class PlanExecutor(Node):
                   % (', '.join(state.stale), self._settings.odom_timeout,
                      ', '.join(self.resolve_topic_name(n + '/odom') for n in state.stale),
                      held, plan_time, timeout))
+        return True
+
+    def _held_too_long(self, run: Run, step: Step, state: FleetState, now: int) -> bool:
+        """
+        End the goal CLOCK_HELD once the clock held hold_timeout with every robot heard.
+
+        A robot that cannot follow (stuck, blocked, stopped by its own e-stop) while its
+        odometry stays fresh held the whole fleet for good before: the clock waits for
+        it, and nothing else ends the goal.
+        """
+        if step.rate > 0.0 or state.stale:
+            run.held_since = None
+            return False
+        if run.held_since is None:
+            run.held_since = now
+        held = (now - run.held_since) * 1e-9
+        timeout = self._settings.hold_timeout
+        if held < timeout:
+            return False
+        plan, limit = run.plan, run.plan.tolerance * self._settings.execution.hold_fraction
+        self._end(run, Result.CLOCK_HELD, 'the plan clock held %.3f s at plan time %.3f s '
+                  '(hold_timeout %g s), the odometry fresh: %s more than hold_fraction x the '
+                  'tracking tolerance (%.6g m) from the reference; every robot was sent zero '
+                  'velocity' % (held, step.plan_time, timeout, ', '.join(
+                      '%s %.3f m' % (plan.names[i], step.errors[i])
+                      for i in np.flatnonzero(step.errors >= limit)), limit))
         return True
 
     def _log_stale(self, run: Run, state: FleetState, plan_time: float) -> None:

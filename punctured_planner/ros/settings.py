@@ -260,8 +260,9 @@ class ExecutorSettings:
         'is refused with UNKNOWN_ROBOTS (s).', low=0.0, high=1e3).field()
     hold_timeout: float = Spec(
         'hold_timeout', 'double', 5.0,
-        'How long the plan clock may hold for stale odometry during a goal (s): then '
-        'every robot gets zero velocity and the goal aborts with ODOMETRY_LOST.',
+        'How long the plan clock may hold during a goal (s): then every robot gets zero '
+        'velocity and the goal aborts, with ODOMETRY_LOST for stale odometry, else with '
+        'CLOCK_HELD (a robot that does not follow).',
         low=0.0, high=1e3).field()
     shared_clock: str = Spec(
         'shared_clock', 'string', 'on',

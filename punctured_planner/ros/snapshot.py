@@ -141,6 +141,14 @@ class RobotOdometry:
     stamp_ns: int
     received_ns: int
 
+    def problem(self) -> str:
+        """Return why the pose is no pose to track ('' when it is one)."""
+        if not np.isfinite(self.position).all():
+            return 'its position %s is not finite' % _point(self.position)
+        if not (np.isfinite(self.orientation).all() and self.orientation.any()):
+            return 'its orientation %s is no rotation' % _point(self.orientation)
+        return ''
+
 
 def take_snapshot(settings: PlannerSettings, obstacles: ObstacleSet,
                   robot_states: RobotState | None,
