@@ -414,7 +414,8 @@ def test_a_goal_for_an_ignored_plan_gets_the_reason_never_an_older_plan():
     plan_executor's store: a message that is no plan is no plan under its id, nor the latest.
 
     Before, a goal for an ignored plan waited 5 s and ended "not there" (the reason only in
-    the executor's log), and a goal for the latest plan (0) ran the plan before it.
+    the executor's log), a goal for the latest plan (0) ran the plan before it, and after a
+    planner restart a goal for plan 2 ran the old planner's plan 2.
     """
     from planner_helpers import faulty_plan
     from punctured_planner.ros import conversions
@@ -435,12 +436,19 @@ def test_a_goal_for_an_ignored_plan_gets_the_reason_never_an_older_plan():
                                      'the path of robot_2 has a non-finite pose'), latest
     assert named.message.startswith('plan 4 on /ns/plan was ignored'), named
     assert store.lookup(3, 'plan').runnable.plan_id == 3
-    store.ignore(3, 'robot_names must be unique')  # heard again, and no plan now
-    assert store.lookup(3, 'plan').runnable is None
     newer = faulty_plan('none')
     newer.plan_id = 5
     store.add(conversions.known_plan(newer))
     assert store.lookup(0, 'plan').runnable.plan_id == 5
+    store.ignore(5, 'robot_names must be unique')  # heard again, and no plan now
+    assert store.lookup(5, 'plan').runnable is None and store.lookup(0, 'plan').plan is None
+    # a restarted planner numbers from 1 again: its plan 1 makes the old ids unknown, so a
+    # goal for its plan 2 waits for that one (before, it ran the old planner's plan 2)
+    again = faulty_plan('none')
+    again.plan_id = 1
+    store.add(conversions.known_plan(again))
+    assert not store.heard(3) and not store.heard(5) and not store.heard(4)
+    assert store.lookup(0, 'plan').runnable.plan_id == 1
 
 
 def test_plan_message_carries_the_acceleration_limit_to_the_executor():
