@@ -187,6 +187,16 @@ def test_differential_fleet_limits_speed_yaw_rate_and_accelerations():
     assert fleet.forward[0] == pytest.approx(0.3) and fleet.yaw_rates[0] == pytest.approx(1.9)
 
 
+def test_a_robot_made_holonomic_faces_x_again_and_moves_as_commanded():
+    """fleet_sim's drive switched at run time: before, the old heading turned +x into -y."""
+    fleet = fleet_of(np.zeros((1, 3)), [1.6], speed_limit=1.0)
+    fleet.configure(FleetSettings(speed_limit=1.0))
+    assert fleet.headings.tolist() == [0.0]
+    fleet.command(0, [0.5, 0.0, 0.0], 0.0)
+    fleet.step(0.0, 0.1)
+    assert np.allclose(fleet.positions, [[0.05, 0.0, 0.0]])
+
+
 def polyline_reference(points, speed):
     """Return a one-robot Reference along points (n, 2) at speed, with a final heading."""
     points = np.c_[np.asarray(points, dtype=float), np.zeros(len(points))]

@@ -72,7 +72,6 @@ class Fleet:
         """Place the robots at rest; no command yet."""
         self.positions = np.array(positions, dtype=float).reshape(-1, 3)
         k = len(self.positions)
-        self.configure(settings)
         self.velocities = np.zeros((k, 3))
         self.headings = np.zeros(k)       # yaw (rad): differential robots turn, others not
         self.forward = np.zeros(k)        # executed forward speeds, differential robots
@@ -85,6 +84,7 @@ class Fleet:
         self._active = np.zeros((k, 4))
         self._active_since = np.full(k, -np.inf)
         self._rng = np.random.default_rng(settings.seed)
+        self.configure(settings)
         self.min_gap = self._start_gap
 
     def configure(self, settings: FleetSettings) -> None:
@@ -106,6 +106,12 @@ class Fleet:
                           else np.asarray(settings.latencies, dtype=float))
         self.differential = (np.zeros(k, dtype=bool) if settings.differential is None
                              else np.asarray(settings.differential, dtype=bool))
+        # A robot made holonomic faces +x again, as its odometry's identity orientation
+        # says: it kept its last heading, which the executor rotated its commands by, so a
+        # command along +x drove it along -y.
+        holonomic = ~self.differential
+        self.headings[holonomic] = self.yaw_rates[holonomic] = self.forward[holonomic] = 0.0
+        self._ramped[holonomic] = 0.0
         self.accelerations = np.broadcast_to(
             np.asarray(settings.max_acceleration, dtype=float), k).copy()
 
