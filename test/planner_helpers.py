@@ -188,4 +188,11 @@ def faulty_plan(fault):
         stamps[2].stamp, stamps[3].stamp = stamps[3].stamp, stamps[2].stamp
     elif fault == 'radii':
         message.obstacle_radii = [0.1] * 2
+    elif fault == 'one pose':
+        for path in message.paths:
+            path.poses = path.poses[:1]
+    elif fault == 'tolerance':
+        message.tracking_tolerance = float('inf')
+    elif fault == 'acceleration':
+        message.max_acceleration = float('inf')
     return message

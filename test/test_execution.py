@@ -393,6 +393,9 @@ def test_plan_message_round_trip_to_the_executor_reference():
     ('nan', 'plan 3: the path of robot_2 has a non-finite pose (pose 1)'),
     ('back', 'plan 3: its stamps do not increase at pose 3'),
     ('radii', 'plan 3 has 2 obstacle_radii for 3 obstacles'),
+    ('one pose', 'plan 3 has 1 pose per path, a motion at least 2'),
+    ('tolerance', 'plan 3: tracking_tolerance inf is more than min_gap / 2'),
+    ('acceleration', 'plan 3: max_acceleration is inf, not a finite number >= 0'),
 ])
 def test_a_plan_message_that_is_not_a_plan_is_refused_naming_the_fault(fault, words):
     """
@@ -400,7 +403,9 @@ def test_a_plan_message_that_is_not_a_plan_is_refused_naming_the_fault(fault, wo
 
     Before, a name that is no ROS name crashed plan_executor when it subscribed to the
     robot's odometry, a NaN pose made a goal command NaN velocities forever, stamps going
-    back ended a goal at once as executed, and one path for two names an IndexError.
+    back ended a goal at once as executed, one path for two names an IndexError, one pose
+    ended a differential goal UNKNOWN, an infinite tolerance never slowed the clock and an
+    infinite acceleration gave NaN references.
     """
     from planner_helpers import faulty_plan
     from punctured_planner.ros import conversions
@@ -449,6 +454,35 @@ def test_a_goal_for_an_ignored_plan_gets_the_reason_never_an_older_plan():
     store.add(conversions.known_plan(again))
     assert not store.heard(3) and not store.heard(5) and not store.heard(4)
     assert store.lookup(0, 'plan').runnable.plan_id == 1
+
+
+def test_the_tracking_tolerance_keeps_the_robots_off_the_walls():
+    """
+    The tolerance is min(min_gap / 2, the smallest gap to a wall), in the reply and the Plan.
+
+    The README's request below walls [-3.3, 3.3, -2.8, 3.8] passed 0.032 m from one, and
+    delta was min_gap / 2 = 0.070 m: a robot within its tolerance could touch the wall.
+    """
+    from planner_helpers import make_request
+    from punctured_planner.cli import offline_plan
+    from punctured_planner.ros import conversions
+    from punctured_planner.ros.settings import PLANNER
+    settings = PLANNER.settings({'obstacles': [-2.0, 0.5, 0.0, 0.0, -0.5, 0.0, 2.5, 0.0, 0.0],
+                                 'robot_radius': 0.18, 'obstacle_radius': [0.15],
+                                 'workspace_bounds': [-3.2, 3.7, -2.7, 3.7]})
+    outcome = offline_plan(make_request(max_speed=0.5), settings, now_ns=10 ** 18)
+    assert outcome.ok, outcome.response.error_msg
+    plan = outcome.plan
+    xy = plan.positions[..., :2]
+    bounds = np.array([[-3.2, 3.7], [-2.7, 3.7]])
+    nearest = min((xy - bounds[:, 0]).min(), (bounds[:, 1] - xy).min()) - 0.18
+    assert plan.wall_gap == pytest.approx(nearest, abs=1e-12)
+    assert plan.wall_gap < plan.min_gap / 2
+    assert outcome.response.tracking_tolerance == plan.wall_gap
+    outcome.plan_id = 1
+    message = conversions.plan_message(outcome, settings)
+    assert message.tracking_tolerance == plan.wall_gap
+    assert conversions.known_plan(message).tolerance == plan.wall_gap
 
 
 def test_plan_message_carries_the_acceleration_limit_to_the_executor():

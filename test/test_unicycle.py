@@ -22,6 +22,8 @@ from punctured_planner.sim import FleetSettings
 import pytest
 from scipy.spatial.transform import Rotation
 
+IDENTITY = (0.0, 0.0, 0.0, 1.0)
+
 angles_st = st.floats(-np.pi, np.pi)
 
 
@@ -160,6 +162,16 @@ def test_drive_must_fit_the_robot_count():
         == [False, True]
     with pytest.raises(ValueError, match='drive has 2 values for 3 robots'):
         ExecutionSettings(drive=('holonomic', 'differential')).differential(3)
+
+
+def test_differential_robots_whose_reference_changes_z_are_found():
+    """plan_executor refuses them (UNKNOWN_ROBOTS): a 3-D plan was accepted, never arrived."""
+    from punctured_planner.execution.execution import leaving_their_plane
+    positions = np.zeros((2, 3, 3))
+    positions[1] = [[1.0, 0.0, 0.0], [1.0, 0.0, 0.5], [0.0, 1.0, 0.5]]
+    reference = Reference(np.array([0.0, 1.0]), positions, np.tile(IDENTITY, (2, 3, 1)))
+    assert leaving_their_plane(np.array([True, True, False]), reference).tolist() == [1]
+    assert leaving_their_plane(np.array([False] * 3), reference).size == 0
 
 
 def test_differential_fleet_ignores_sideways_commands_and_follows_arcs():

@@ -32,7 +32,7 @@ from .strata import epsilon, projection_count, projection_gaps
 from .timing import (corner_jump, leg_at, length_times, resample, speed_profile, SpeedProfile,
                      stamps as timed_stamps)
 from .validation import validate_configurations
-from .walls import smallest_leg_slack
+from .walls import smallest_leg_slack, WallSlack
 
 
 @dataclass(frozen=True, eq=False)
@@ -166,6 +166,23 @@ class Plan:
     def min_gap(self) -> float:
         """Return the exact minimum surface gap over the whole motion; negative means contact."""
         return self.gap.distance
+
+    @cached_property
+    def wall_slack(self) -> WallSlack | None:
+        """
+        Return the exact smallest slack of a robot's body to a wall (None without walls).
+
+        Its slack is the body's distance to the wall (centre less robot_radius), the
+        robot, wall and first leg that reach it named (core.walls.smallest_leg_slack).
+        """
+        bounds = self.workspace.bounds
+        return (None if bounds is None
+                else smallest_leg_slack(self.positions, bounds, self.workspace.robot_radius))
+
+    @property
+    def wall_gap(self) -> float:
+        """Return the smallest gap of a robot's body to a wall over the motion (inf: no walls)."""
+        return np.inf if self.wall_slack is None else self.wall_slack.slack
 
     def segment_of(self, leg: int) -> int:
         """Return m, 0-based, of the segment C_{m+1} -> C_{m+2} that leg [leg, leg + 1] is in."""
@@ -413,12 +430,8 @@ def _check_inside(result: Plan) -> None:
     Exact (smallest_leg_slack); the error names the robot, the wall, how far
     beyond it the robot reaches, and the first leg that reaches that far.
     """
-    workspace = result.workspace
-    bounds = workspace.bounds
-    if bounds is None:
-        return
-    worst = smallest_leg_slack(result.positions, bounds, workspace.robot_radius)
-    if worst.slack >= 0:
+    workspace, bounds, worst = result.workspace, result.workspace.bounds, result.wall_slack
+    if bounds is None or worst is None or worst.slack >= 0:
         return
     leg = worst.index
     ends = result.positions[leg:leg + 2, worst.body, worst.wall.axis]

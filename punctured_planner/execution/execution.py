@@ -109,6 +109,12 @@ def differential_mask(drive: tuple, robot_count: int) -> np.ndarray:
     return np.broadcast_to(np.asarray(drive) == DIFFERENTIAL, robot_count).copy()
 
 
+def leaving_their_plane(differential: np.ndarray, reference: Reference) -> np.ndarray:
+    """Return the indices of the differential robots whose reference changes z: no unicycle can."""
+    heights = reference.positions[..., 2]
+    return np.flatnonzero(differential & (heights.max(axis=0) > heights.min(axis=0)))
+
+
 @dataclass(frozen=True)
 class Step:
     """What one control step decided: the clock, the references and the commands."""

@@ -17,9 +17,16 @@ robot can move in one control step and its command latency.
 import numpy as np
 
 
-def tracking_tolerance(min_gap: float) -> float:
-    """Return delta = min_gap / 2: the largest safe deviation of a robot from its reference."""
-    return 0.5 * float(min_gap)
+def tracking_tolerance(min_gap: float, wall_gap: float = np.inf) -> float:
+    """
+    Return delta = min(min_gap / 2, wall_gap): the largest safe deviation from a reference.
+
+    Two bodies each within delta of their references close by at most 2 delta <=
+    min_gap, a body and a pillar by delta; a body and a wall (its reference wall_gap
+    from it) by delta <= wall_gap: a robot within the tolerance that ignored the walls
+    could touch a wall its reference passes closer than min_gap / 2.
+    """
+    return min(0.5 * float(min_gap), float(wall_gap))
 
 
 def clock_rate(errors: np.ndarray, tolerance: float, slow_fraction: float,

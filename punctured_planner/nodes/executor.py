@@ -66,6 +66,7 @@ from scipy.spatial.transform import Rotation
 from ..execution import Execution
 from ..execution import Step
 from ..execution.execution import differential_mask
+from ..execution.execution import leaving_their_plane
 from ..ros import conversions
 from ..ros.goals import fleet_state
 from ..ros.goals import FleetState
@@ -333,12 +334,19 @@ class PlanExecutor(Node):
         """
         Return plan with NONE, or UNKNOWN_ROBOTS if drive has not one value or one per robot.
 
-        The same for max_speeds and max_accelerations (which may also be empty).
+        The same for max_speeds and max_accelerations (which may also be empty), and for
+        a differential robot whose path leaves its plane (z): it was accepted, and never
+        arrived.
         """
         settings, count = self._settings.execution, len(plan.names)
         try:
-            differential_mask(settings.drive, count)
+            differential = differential_mask(settings.drive, count)
             settings.limits(count)
+            climbing = leaving_their_plane(differential, plan.reference)
+            if climbing.size:
+                raise ValueError('drive makes %s differential, and a differential robot moves '
+                                 'in its plane only: its path changes z'
+                                 % ', '.join(plan.names[i] for i in climbing))
         except ValueError as error:
             return Lookup(plan, Result.UNKNOWN_ROBOTS, 'plan %d has robots %s: %s'
                           % (plan.plan_id, ', '.join(plan.names), error))

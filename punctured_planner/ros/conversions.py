@@ -393,7 +393,7 @@ def fill_response(response: PlanSequence.Response, plan: core.Plan, paths: Seque
     response.paths = paths
     response.waypoint_indices = [int(i) for i in np.asarray(waypoints).tolist()]
     response.dropped_configurations = [int(m) for m in dropped]
-    response.tracking_tolerance = tracking_tolerance(plan.min_gap)
+    response.tracking_tolerance = tracking_tolerance(plan.min_gap, plan.wall_gap)
     return response
 
 
@@ -430,7 +430,8 @@ def plan_message(outcome: Outcome, settings: PlannerSettings) -> Plan:
     Return the punctured_planner_interfaces/Plan of a successful Outcome (topic ``plan``).
 
     The bodies are the workspace's (robot radius, obstacles and their radii); the
-    tracking tolerance is execution.tracking_tolerance(min_gap).
+    tracking tolerance is execution.tracking_tolerance(min_gap, wall_gap): the
+    walls are not in the message, their gap is in the tolerance.
     """
     planned = outcome.planned()
     plan = planned.plan
@@ -443,7 +444,7 @@ def plan_message(outcome: Outcome, settings: PlannerSettings) -> Plan:
                 max_acceleration=float(outcome.max_acceleration),
                 robot_radius=float(workspace.robot_radius), obstacles=obstacles,
                 obstacle_radii=np.asarray(workspace.obstacle_radii, dtype=float).tolist(),
-                min_gap=min_gap, tracking_tolerance=tracking_tolerance(min_gap))
+                min_gap=min_gap, tracking_tolerance=tracking_tolerance(min_gap, plan.wall_gap))
 
 
 def path_arrays(path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -462,17 +463,21 @@ def plan_reference(msg: Plan) -> Reference:
 
     Raises ValueError, naming the plan and the robot, unless the message is a
     plan: one path per robot, the robots' names unique ROS names (each names
-    its topics), every pose (position and orientation) finite, and one clock:
-    the same stamps on every path, strictly increasing.
+    its topics), every pose (position and orientation) finite, one clock (the
+    same stamps on every path, at least two, strictly increasing) and numbers
+    a plan can have (plan_numbers).
     """
+    plan_numbers(msg)
     if len(msg.robot_names) != len(msg.paths):
         raise ValueError('plan %d has %d robot_names and %d paths, one per robot'
                          % (msg.plan_id, len(msg.robot_names), len(msg.paths)))
     ros_names('plan %d: robot_names' % msg.plan_id, tuple(msg.robot_names))
     arrays = [path_arrays(path) for path in msg.paths]
     stamps = [a[0] for a in arrays]
-    if not stamps or stamps[0].size == 0:
-        raise ValueError('plan %d has no poses' % msg.plan_id)
+    if not stamps or stamps[0].size < 2:
+        count = stamps[0].size if stamps else 0
+        raise ValueError('plan %d has %d pose%s per path, a motion at least 2'
+                         % (msg.plan_id, count, '' if count == 1 else 's'))
     for name, (robot_stamps, positions, orientations) in zip(msg.robot_names, arrays):
         if not np.array_equal(robot_stamps, stamps[0]):
             raise ValueError('plan %d: the path of %s does not have the stamps of %s'
@@ -490,6 +495,28 @@ def plan_reference(msg: Plan) -> Reference:
     orientations = normalized_quaternions(np.stack([a[2] for a in arrays], axis=1))
     return Reference.timed(seconds, positions, orientations, float(msg.max_speed),
                            float(msg.max_acceleration), float(msg.min_gap))
+
+
+def plan_numbers(msg: Plan) -> None:
+    """
+    Raise ValueError, naming the field, unless a Plan's numbers are ones a plan has.
+
+    max_speed finite and > 0, max_acceleration and robot_radius finite and >= 0,
+    min_gap a number, and tracking_tolerance at most min_gap / 2 (a larger one
+    let robots touch while the clock ran on; NaN or inf limits gave NaN references).
+    """
+    speed, acceleration = float(msg.max_speed), float(msg.max_acceleration)
+    radius, gap, tolerance = (float(msg.robot_radius), float(msg.min_gap),
+                              float(msg.tracking_tolerance))
+    for name, value, low, strict in (('max_speed', speed, 0.0, True),
+                                     ('max_acceleration', acceleration, 0.0, False),
+                                     ('robot_radius', radius, 0.0, False)):
+        if not (np.isfinite(value) and (value > low if strict else value >= low)):
+            raise ValueError('plan %d: %s is %r, not a finite number %s 0'
+                             % (msg.plan_id, name, value, '>' if strict else '>='))
+    if np.isnan(gap) or not tolerance <= 0.5 * gap:
+        raise ValueError('plan %d: tracking_tolerance %r is more than min_gap / 2 (min_gap %r)'
+                         % (msg.plan_id, tolerance, gap))
 
 
 def plan_bodies(msg: Plan) -> Bodies:

@@ -108,7 +108,8 @@ class PlanStore:
         if not plan.tolerance > 0:
             return Lookup(plan, Result.UNSAFE_PLAN, (
                 'plan %d has min_gap %.6g m, tracking tolerance %.6g m: its bodies touch '
-                'even when executed exactly' % (plan.plan_id, plan.min_gap, plan.tolerance)))
+                '(each other, a pillar or a wall) even when executed exactly'
+                % (plan.plan_id, plan.min_gap, plan.tolerance)))
         return Lookup(plan, Result.NONE)
 
 
