@@ -43,7 +43,9 @@ velocity once more before the node goes.
 from dataclasses import dataclass
 from dataclasses import field
 import functools
+import math
 import sys
+import time
 from typing import Any
 
 from geometry_msgs.msg import PoseStamped
@@ -78,6 +80,7 @@ from ..ros.qos import COMMANDS
 from ..ros.qos import LATCHED
 from ..ros.qos import STATE
 from ..ros.runtime import NodeGroup
+from ..ros.runtime import REQUEST_GRACE_SEC
 from ..ros.runtime import run_nodes
 from ..ros.settings import EXECUTOR
 from ..ros.settings import ExecutorSettings
@@ -147,6 +150,7 @@ class PlanExecutor(Node):
         # value and are not hashable), and, once a stop began, the Future done when none is.
         self._unfinished: set[bytes] = set()
         self._all_out: Future | None = None
+        self._last_result = -math.inf  # time.monotonic() when the last result went out
         self.create_subscription(Plan, 'plan', self._on_plan, LATCHED)
         self._server = ActionServer(self, ExecutePlan, 'execute_plan', self._execute,
                                     goal_callback=self._on_goal,
@@ -253,6 +257,7 @@ class PlanExecutor(Node):
         finally:
             # The action server sends the result as this coroutine returns, in the same step.
             self._unfinished.discard(bytes(goal.goal_id.uuid))
+            self._last_result = time.monotonic()
             if self._all_out is not None and not self._unfinished:
                 self._all_out.set_result(True)
 
@@ -539,8 +544,11 @@ class PlanExecutor(Node):
         Refuse new goals; end every goal STOPPED, the active one's robots stopped (before_stop).
 
         Every accepted goal: running, waiting for its plan, or not started yet (it ends
-        as it starts). Return the Future that is done once every result is out, None
-        without a goal.
+        as it starts). Return the Future that is done once every result is out: done
+        already when none is pending but a result went out within REQUEST_GRACE_SEC
+        (the stop's grace spin then answers a client asking for it a moment late: one
+        that asked after its cancel's reply, at a stop, got nothing in 1 of 3 runs);
+        None otherwise.
         """
         self._stopping = True
         for wait in self._waits:
@@ -551,10 +559,14 @@ class PlanExecutor(Node):
             self._end(run, Result.STOPPED, 'plan_executor stopped at plan time %.3f s; its '
                       'robots were sent zero velocity'
                       % (run.execution.plan_time if run.execution else 0.0))
-        if not self._unfinished:
+        if self._unfinished:
+            self._all_out = Future()
+            return self._all_out
+        if time.monotonic() - self._last_result > REQUEST_GRACE_SEC:
             return None
-        self._all_out = Future()
-        return self._all_out
+        just_out = Future()
+        just_out.set_result(True)
+        return just_out
 
     def stop_halted_robots(self) -> None:
         """Send zero velocity again to the robots end_goals stopped: the last command they get."""
