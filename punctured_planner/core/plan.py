@@ -44,7 +44,8 @@ class Samples:
     ``waypoints[m]`` is the index of the pose at C_m, which is present exactly.
     A breakpoint that repeats the previous one's time and positions (the end
     of a leg in which no robot moves) is left out, so stamps strictly increase
-    wherever the robots move (doc/design.md section 8).
+    wherever the robots move by more than the stamps' rounding (doc/design.md
+    section 8).
     """
 
     values: np.ndarray
