@@ -43,6 +43,24 @@ EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a tool stopped by Ctr
 EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, as a shell reports a tool whose reader went away
 
 
+def ros_name(text: str) -> str:
+    """
+    Return text if it is a valid ROS name for a service or a node, else raise ArgumentTypeError.
+
+    A name rclpy refuses raised from inside it, a traceback and exit 1 (the code of a
+    planner error).
+    """
+    from rclpy.expand_topic_name import expand_topic_name
+    from rclpy.validate_full_topic_name import validate_full_topic_name
+    try:
+        validate_full_topic_name(expand_topic_name(text, 'punctured_planner', '/'),
+                                 is_service=True)
+    except Exception as error:  # noqa: B902 - rclpy raises ValueError or its own kinds
+        raise argparse.ArgumentTypeError('%r is not a valid ROS name: %s'
+                                         % (text, str(error).split(', at ')[0]))
+    return text
+
+
 def load_request(path: str) -> Any:
     """Read a YAML request file (``-`` for standard input) into plain data."""
     if path == '-':
@@ -204,6 +222,8 @@ def reset_obstacles(node: 'Node', executor: 'Executor', planner_node: str,
     if got is None or not got.values:
         return 'no obstacles parameter on %s' % planner_node
     current = parameter_value_to_python(got.values[0])
+    if current is None:  # obstacles: [] in a parameter file leaves no type: none
+        current = []
     try:  # integers too: the parameter is dynamically typed (obstacles: [0, 1, 0])
         values = [float(v) for v in current]
     except (TypeError, ValueError):
@@ -233,9 +253,15 @@ def print_response(response: Any, no_paths: bool = False) -> int:
     from punctured_planner.ros.msg_dict import message_to_dict
     from punctured_planner_interfaces.srv import PlanSequence
 
-    data = message_to_dict(response)
+    paths = response.paths
+    if no_paths:  # not converted at all: 1.5 million poses took 55 s to convert and drop
+        response.paths = []
+    try:
+        data = message_to_dict(response)
+    finally:
+        response.paths = paths
     if no_paths:
-        data['paths'] = '(%d paths omitted)' % len(response.paths)
+        data['paths'] = '(%d paths omitted)' % len(paths)
     yaml.safe_dump(data, sys.stdout, sort_keys=False)
     names = [n for n in constant_names(PlanSequence.Response, response.error_code)
              if n != 'NONE' or response.error_code == 0]
@@ -280,7 +306,7 @@ def _plan(args):
     from punctured_planner.render import render_outputs
 
     try:
-        values = load_parameter_file(args.params, PLANNER.node_name) if args.params else {}
+        values = load_parameter_file(args.params, PLANNER) if args.params else {}
         settings = PLANNER.settings(values)
     except (OSError, yaml.YAMLError, ValueError) as error:
         print('punctured-planner: bad parameter file: %s' % error, file=sys.stderr)
@@ -301,7 +327,8 @@ def _plan(args):
     title = os.path.basename(args.request) if args.request != '-' else None
     try:
         written = render_outputs(args, outcome.planned().plan, title=title,
-                                 max_speed=outcome.max_speed)
+                                 max_speed=outcome.max_speed,
+                                 max_acceleration=outcome.max_acceleration)
         if args.mcap:
             written.append(record_plan(args.mcap, outcome, settings))
     except OSError as error:  # the plan is printed; an output file could not be written
@@ -327,7 +354,7 @@ def make_parser(pictures: bool = True) -> argparse.ArgumentParser:
     call = commands.add_parser(
         'call', help='send a PlanSequence request (YAML file) and print the response')
     call.add_argument('request', help="YAML request file, '-' for standard input")
-    call.add_argument('--service', default='/plan_sequence',
+    call.add_argument('--service', default='/plan_sequence', type=ros_name,
                       help='service name (default: %(default)s)')
     call.add_argument('--wait', type=float, default=10.0,
                       help='seconds to wait for the service to appear (default: %(default)s)')
@@ -339,7 +366,7 @@ def make_parser(pictures: bool = True) -> argparse.ArgumentParser:
     reset = commands.add_parser(
         'reset-obstacles', help="go back to the node's obstacles parameter, replacing a set "
         "that came on the 'obstacles' topic")
-    reset.add_argument('--node', default='/planner_node',
+    reset.add_argument('--node', default='/planner_node', type=ros_name,
                        help='the planner node (default: %(default)s)')
     reset.add_argument('--wait', type=float, default=10.0,
                        help='seconds to wait for the node (default: %(default)s)')

@@ -141,7 +141,7 @@ def _run(recorder, request_path, mcap_path, gif_path, fleet):
     planned = response.duration.sec + response.duration.nanosec * 1e-9
     print('planned plan %d: %d robots, %.2f s at %.2f m/s, min gap %.3f m, tolerance %.3f m'
           % (response.plan_id, len(response.paths), planned, request.max_speed,
-             2 * response.tracking_tolerance, response.tracking_tolerance))
+             response.min_gap, response.tracking_tolerance))
     watch = GoalWatch()
     goal = action.send_goal_async(ExecutePlan.Goal(plan_id=response.plan_id),
                                   feedback_callback=watch.heard)
@@ -279,6 +279,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument('--drive', choices=('holonomic', 'differential'),
                         help="override fleet_sim's and plan_executor's drive (all robots)")
     args = parser.parse_args(argv)
+    for path in (args.mcap, args.gif):  # written after the run: say so before it, not after
+        folder = os.path.dirname(os.path.abspath(path))
+        if not os.path.isdir(folder):
+            parser.error('cannot write %s: no folder %s' % (path, folder))
     os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
     with open(args.params, encoding='utf-8') as stream:
         values = yaml.safe_load(stream)

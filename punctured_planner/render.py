@@ -12,21 +12,45 @@ command of ``punctured-planner`` gets ``--png``/``--gif`` with two lines::
 
 import argparse
 from collections.abc import Sequence
+import math
 import os
 import sys
 
 from .core import Plan
 from .viz import domain_picture, example_plan, render_animation, render_png
+from .viz.animation import MAX_FPS, MAX_SECONDS
+
+# Resolutions the pictures are drawn at: far below, an empty image; far above, no memory.
+MIN_DPI, MAX_DPI = 10, 1000
 
 
 def _positive_float(text):
-    """Return text as a float > 0, or raise argparse.ArgumentTypeError."""
+    """Return text as a finite float > 0, or raise argparse.ArgumentTypeError."""
     try:
         value = float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f'{text!r} is not a number')
-    if not value > 0:
-        raise argparse.ArgumentTypeError(f'{text!r} is not positive')
+    if not 0 < value < math.inf:
+        raise argparse.ArgumentTypeError(f'{text!r} is not a positive finite number')
+    return value
+
+
+def _at_most(high):
+    """Return an argparse type: a positive finite float at most high."""
+    def value_of(text):
+        value = _positive_float(text)
+        if value > high:
+            raise argparse.ArgumentTypeError(f'{text!r} is more than {high:g}')
+        return value
+    return value_of
+
+
+def _dpi(text):
+    """Return text as a resolution in [MIN_DPI, MAX_DPI], or raise argparse.ArgumentTypeError."""
+    value = _positive_float(text)
+    if not MIN_DPI <= value <= MAX_DPI:
+        raise argparse.ArgumentTypeError(f'{text!r} is not in [{MIN_DPI}, {MAX_DPI}] dots per '
+                                         'inch (1e-3 drew an empty image, 1e5 ran out of memory)')
     return value
 
 
@@ -44,13 +68,15 @@ def add_render_arguments(parser: argparse.ArgumentParser) -> argparse._ArgumentG
                        help='draw the plan (paths, lanes, waypoints, domain, clearance)')
     group.add_argument('--gif', metavar='OUT.gif', type=_gif_path,
                        help='animate the synchronous motion of all robots')
-    group.add_argument('--gif-fps', type=_positive_float, default=20.0,
-                       help='frames per second of the animation (default: %(default)s)')
-    group.add_argument('--gif-seconds', type=_positive_float, default=8.0,
-                       help='length of the animation in seconds (default: %(default)s)')
-    group.add_argument('--gif-dpi', type=_positive_float, default=80.0,
+    group.add_argument('--gif-fps', type=_at_most(MAX_FPS), default=20.0,
+                       help='frames per second of the animation, at most 50 '
+                       '(default: %(default)s)')
+    group.add_argument('--gif-seconds', type=_at_most(MAX_SECONDS), default=8.0,
+                       help='length of the animation in seconds, at most 60 '
+                       '(default: %(default)s)')
+    group.add_argument('--gif-dpi', type=_dpi, default=80.0,
                        help='resolution of the animation (default: %(default)s)')
-    group.add_argument('--dpi', type=_positive_float, default=100.0,
+    group.add_argument('--dpi', type=_dpi, default=100.0,
                        help='resolution of the PNG picture (default: %(default)s)')
     group.add_argument('--raw', action='store_true',
                        help="overlay the construction's unrefined motion, dashed, on the PNG")
@@ -58,7 +84,8 @@ def add_render_arguments(parser: argparse.ArgumentParser) -> argparse._ArgumentG
 
 
 def render_outputs(args: argparse.Namespace, plan: Plan, title: str | None = None,
-                   max_speed: float = 1.0) -> list[str | os.PathLike[str]]:
+                   max_speed: float = 1.0,
+                   max_acceleration: float = 0.0) -> list[str | os.PathLike[str]]:
     """Write the pictures asked for by add_render_arguments' options; return their paths."""
     written: list[str | os.PathLike[str]] = []
     if getattr(args, 'png', None):
@@ -67,7 +94,8 @@ def render_outputs(args: argparse.Namespace, plan: Plan, title: str | None = Non
     if getattr(args, 'gif', None):
         written.append(render_animation(plan, args.gif, fps=args.gif_fps,
                                         seconds=args.gif_seconds, dpi=args.gif_dpi,
-                                        title=title, max_speed=max_speed))
+                                        title=title, max_speed=max_speed,
+                                        max_acceleration=max_acceleration))
     return written
 
 
@@ -94,7 +122,7 @@ def make_parser() -> argparse.ArgumentParser:
     domain.add_argument('output', metavar='OUT.png')
     domain.add_argument('--robots', type=int, choices=(1, 2), default=1,
                         help='number of robots (default: %(default)s)')
-    domain.add_argument('--dpi', type=_positive_float, default=100.0,
+    domain.add_argument('--dpi', type=_dpi, default=100.0,
                         help='resolution (default: %(default)s)')
     domain.set_defaults(func=_domain)
     example = commands.add_parser('example', help='the example plan (PNG and/or GIF)')

@@ -146,7 +146,7 @@ def scenario_plan(configurations=CONFIGURATIONS):
     from punctured_planner.ros.parameters import load_parameter_file
     from punctured_planner.ros.settings import PLANNER
     settings = PLANNER.settings(load_parameter_file(
-        os.path.join(REPO_ROOT, 'config', 'default_scenario.yaml'), PLANNER.node_name))
+        os.path.join(REPO_ROOT, 'config', 'default_scenario.yaml'), PLANNER))
     return core_plan(configurations, variant=settings.core_variant,
                      lane_spacing=settings.lane_spacing, min_spacing=settings.min_spacing,
                      required_clearance=settings.required_clearance,

@@ -75,18 +75,29 @@ def test_workspace_bounds_become_the_cores_box_for_the_dimension():
 
 def test_parameter_files(tmp_path):
     values = load_parameter_file(os.path.join(REPO_ROOT, 'config', 'default_scenario.yaml'),
-                                 PLANNER.node_name)
+                                 PLANNER)
     settings = PLANNER.settings(values)
     assert settings.robot_count == 4 and len(settings.obstacles) == 9
     path = tmp_path / 'p.yaml'
     path.write_text('/**:\n  ros__parameters: {variant: paper}\n'
                     'other_node:\n  ros__parameters: {variant: spread}\n'
                     '/fleet/planner_node:\n  ros__parameters: {max_speed: 2}\n')
-    assert load_parameter_file(str(path), 'planner_node') == {'variant': 'paper',
-                                                              'max_speed': 2}
+    assert load_parameter_file(str(path), PLANNER) == {'variant': 'paper', 'max_speed': 2}
+    # what planner_node starts with: a shared section with rclpy's and other nodes'
+    # parameters (refused as unknown before), while its own section's typo is one
+    path.write_text('/**:\n  ros__parameters: {use_sim_time: false, speed_limit: 1.0, '
+                    'frame_id: odom}\n'
+                    'planner_node:\n  ros__parameters: {use_sim_time: false, max_sped: 2}\n')
+    values = load_parameter_file(str(path), PLANNER)
+    assert values == {'frame_id': 'odom', 'max_sped': 2}
+    with pytest.raises(ValueError, match="unknown parameter 'max_sped'"):
+        PLANNER.settings(values)
+    path.write_text('planer_node:\n  ros__parameters: {max_speed: 2}\n')
+    with pytest.raises(ValueError, match='no section applies to planner_node'):
+        load_parameter_file(str(path), PLANNER)
     path.write_text('- not a mapping\n')
     with pytest.raises(ValueError):
-        load_parameter_file(str(path), 'planner_node')
+        load_parameter_file(str(path), PLANNER)
 
 
 @pytest.mark.parametrize('table, values, words', [

@@ -644,7 +644,7 @@ def test_a_bad_obstacle_set_is_refused_on_arrival(planner, ros_client, monkeypat
     assert np.array_equal(node.node.snapshot().obstacles.points, OBSTACLES)
 
 
-def test_reset_obstacles_keeps_an_obstacles_parameter_given_as_integers(planner, ros_client):
+def test_reset_obstacles_keeps_an_obstacles_parameter_of_integers_or_empty(planner, ros_client):
     """
     punctured-planner reset-obstacles sets the parameter's own value again, integers too.
 
@@ -664,3 +664,8 @@ def test_reset_obstacles_keeps_an_obstacles_parameter_given_as_integers(planner,
                            10.0) is None
     assert node.node.snapshot().obstacles.source == 'parameter'
     assert node.node.snapshot().obstacles.points.tolist() == [[0, 2, 0], [3, 0, 0]]
+    # obstacles: [] (no obstacles) as a parameter file gives it: no value type at all
+    empty = planner(obstacles=None)
+    assert reset_obstacles(ros_client.node, ros_client.executor, empty.name('planner_node'),
+                           10.0) is None
+    assert empty.node.snapshot().obstacles.points.size == 0

@@ -200,7 +200,7 @@ def test_bundled_scenario_refuses_a_goal_grazing_an_obstacle():
     from planner_helpers import CONFIGURATIONS
     from punctured_planner.ros.parameters import load_parameter_file
     values = load_parameter_file(os.path.join(REPO_ROOT, 'config', 'default_scenario.yaml'),
-                                 PLANNER.node_name)
+                                 PLANNER)
     settings = PLANNER.settings(values)
     assert settings.required_clearance > 0
     snapshot = Snapshot(settings, ObstacleSet(conversions.obstacles_from_parameter(

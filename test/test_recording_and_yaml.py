@@ -24,3 +24,24 @@ def test_request_yaml_integers_out_of_range_are_refused():
         fill_message(PlanSequence.Request(), {'samples_per_leg': 99999999999})
     request = fill_message(PlanSequence.Request(), {'samples_per_leg': -1})
     assert request.samples_per_leg == -1
+
+
+def test_request_yaml_numbers_in_exponent_form_are_numbers():
+    """
+    1e-05, as JSON writes it, is a string to PyYAML (YAML 1.1): taken as ros2 cli takes it.
+
+    Before, 'expected a number, got '1e-05'' and exit 2; words stay refused.
+    """
+    import yaml
+
+    from punctured_planner.ros.msg_dict import fill_message
+    from punctured_planner_interfaces.srv import PlanSequence
+    data = yaml.safe_load('{max_speed: 1e-05, configurations: [{poses: [{position: '
+                          '{x: 3e0, y: -2.5E+1, z: .5e1}}]}]}')
+    request = fill_message(PlanSequence.Request(), data)
+    assert request.max_speed == 1e-05
+    assert [request.configurations[0].poses[0].position.x,
+            request.configurations[0].poses[0].position.y,
+            request.configurations[0].poses[0].position.z] == [3.0, -25.0, 5.0]
+    with pytest.raises(ValueError, match="expected a number, got 'fast'"):
+        fill_message(PlanSequence.Request(), {'max_speed': 'fast'})

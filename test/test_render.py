@@ -69,36 +69,45 @@ def test_render_png_without_obstacles_or_second_robot(tmp_path):
     assert_picture(path, minimum_bytes=5000)
 
 
-def test_frame_parameters_keep_every_breakpoint_and_follow_time():
-    """Frames start at 0, end at 1, contain every breakpoint and are nearly time-uniform."""
+def test_frame_parameters_are_evenly_spaced_in_the_plans_time():
+    """Frames start at 0, end at 1 and are time-uniform, under an acceleration limit too."""
     p = example_plan()
-    # More frames than the refined plan's breakpoints, so the budget is what counts.
-    assert p.times.size < 400
-    tau, seconds = frame_parameters(p, 400)
-    assert tau[0] == 0.0 and tau[-1] == 1.0
-    assert np.all(np.diff(tau) > 0) and np.all(np.diff(seconds) >= 0)
-    assert abs(tau.size - 400) <= 1
-    frames = p.position(tau)
-    for corner in p.positions:
-        assert np.any(np.all(np.isclose(frames, corner, atol=1e-12), axis=(1, 2)))
-    total = p.duration(1.0)
-    assert seconds[-1] == pytest.approx(total)
-    assert np.diff(seconds).max() <= 2.5 * total / 400
+    for acceleration in (0.0, 0.5):
+        tau, seconds = frame_parameters(p, 40, 1.0, acceleration)
+        assert tau.size == 40 and tau[0] == 0.0 and tau[-1] == 1.0
+        assert np.all(np.diff(tau) > 0)
+        assert seconds[-1] == pytest.approx(p.duration(1.0, acceleration))
+        assert np.allclose(np.diff(seconds), seconds[-1] / 39)
+        # each frame is where the plan is at its time
+        assert np.allclose(np.interp(tau, p.times, p.stamps(1.0, acceleration)), seconds)
 
 
-def test_render_animation_writes_a_gif_with_many_frames(tmp_path):
-    """The GIF has one frame per frame parameter, and the robots move between them."""
+def test_render_animation_lasts_its_seconds_and_passes_every_breakpoint(tmp_path):
+    """
+    The GIF has fps x seconds frames of 1 / fps each; the trails pass every breakpoint.
+
+    Before, every breakpoint was a frame as well: 145 frames of 500 ms (72.5 s) for fps 2
+    and 1 s, and the clock ignored max_acceleration.
+    """
     p = example_plan()
     path = tmp_path / 'plan.gif'
+    assert p.times.size > 12
     assert render_animation(p, path, fps=6, seconds=2, dpi=50) == path
     assert path.stat().st_size > 10000
     with Image.open(path) as image:
         assert image.format == 'GIF'
-        assert image.n_frames == frame_parameters(p, 12)[0].size > 1
-        first = np.asarray(image.convert('RGB'))
-        image.seek(image.n_frames - 1)
+        assert image.n_frames == 12
+        durations = []
+        for frame in range(image.n_frames):
+            image.seek(frame)
+            durations.append(image.info['duration'])
         last = np.asarray(image.convert('RGB'))
+        image.seek(0)
+        first = np.asarray(image.convert('RGB'))
+    assert abs(sum(durations) - 2000) <= 12 * 10
     assert np.any(first != last)
+    with pytest.raises(ValueError, match='fps must be in'):
+        render_animation(p, tmp_path / 'fast.gif', fps=100, seconds=1)
 
 
 def test_render_animation_three_d(tmp_path):

@@ -45,12 +45,18 @@ def _integer_range(type_name: str) -> tuple[int, int]:
     return -2 ** (bits - 1), 2 ** (bits - 1) - 1
 
 
+# A number in exponent form without a decimal point, which PyYAML leaves a string.
+EXPONENT_NUMBER = re.compile(r'[-+]?(\d+\.?\d*|\.\d+)[eE][-+]?\d+')
+
+
 def _convert_scalar(type_name: str, value: Any, where: str) -> Any:
     if type_name == 'boolean':
         if not isinstance(value, bool):
             raise ValueError('%s: expected true or false, got %r' % (where, value))
         return value
     if type_name in ('float', 'double'):
+        if isinstance(value, str) and EXPONENT_NUMBER.fullmatch(value):
+            return float(value)  # YAML 1.1 reads 1e-05 (JSON's) as a string; ros2 cli takes it
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise ValueError('%s: expected a number, got %r' % (where, value))
         return float(value)

@@ -336,29 +336,44 @@ class NodeParameters(Generic[S]):
             '%s=%r' % (p.name, p.value) for p in parameters))
 
 
-def load_parameter_file(path: str, node_name: str) -> dict:
+# Parameters rclpy declares on every node: a file may set them; they are not ours.
+RCLPY_PARAMETERS = ('use_sim_time', 'start_type_description_service')
+
+
+def load_parameter_file(path: str, table: Table) -> dict:
     """
     Return one node's parameter values from a ROS 2 parameter YAML file.
 
     Sections that apply to the node are merged in file order: ``/**``, the node's
-    name with or without a leading slash or namespace. Raises ValueError for a
-    file that is not a ROS parameter file.
+    name with or without a leading slash or namespace. As a node takes what it
+    declares, a ``/**`` section gives only the table's parameters (the others are
+    other nodes'), and rclpy's own (use_sim_time) are left out; a name the node's
+    own section sets and the table lacks is kept (settings() refuses it: a typo).
+    Raises ValueError for a file that is not a ROS parameter file, or none of
+    whose sections applies to the node.
     """
     with open(path, encoding='utf-8') as stream:
         data = yaml.safe_load(stream) or {}
     if not isinstance(data, dict):
         raise ValueError('%s: not a ROS parameter file (a mapping of node names)' % path)
     values: dict = {}
+    applied = False
     for key, section in data.items():
         key = str(key)
-        applies = key in ('/**', '**') or key.rstrip('/').split('/')[-1] == node_name
-        if not applies:
+        shared = key in ('/**', '**')
+        if not shared and key.rstrip('/').split('/')[-1] != table.node_name:
             continue
+        applied = True
         if not isinstance(section, dict) or 'ros__parameters' not in section:
             raise ValueError('%s: section %r has no ros__parameters' % (path, key))
         parameters = section['ros__parameters'] or {}
         if not isinstance(parameters, dict):
             raise ValueError('%s: section %r: ros__parameters must map names to values, got %r'
                              % (path, key, parameters))
-        values.update(parameters)
+        values.update((name, value) for name, value in parameters.items()
+                      if name not in RCLPY_PARAMETERS
+                      and (name in table.by_name or not shared))
+    if data and not applied:
+        raise ValueError('%s: no section applies to %s (sections: %s; /** or %s)'
+                         % (path, table.node_name, ', '.join(map(str, data)), table.node_name))
     return values

@@ -1,10 +1,11 @@
 """
 render_animation: the synchronous motion as an animated GIF, all robots moving together.
 
-Frames follow the time parameterisation of the plan (each leg lasts as long as
-its fastest robot needs at max_speed), every breakpoint position is a frame and
-each robot leaves a trail, so a viewer sees the robots switch legs together and
-never meet.
+Frames are evenly spaced in the plan's time (each leg lasts as long as its
+fastest robot needs at max_speed, under max_acceleration when one is given),
+fps x seconds of them, so the GIF lasts seconds; each robot leaves a trail
+through every breakpoint it has passed, so a viewer sees the robots switch legs
+together and never meet.
 """
 
 import os
@@ -23,40 +24,30 @@ from ..core import Plan
 from ..core.timing import leg_at
 
 
-def _allocate(durations, budget):
-    """Split budget frames over legs in proportion to their durations (largest remainder)."""
-    quotas = durations / durations.sum() * budget
-    counts = np.floor(quotas).astype(int)
-    remainder = budget - counts.sum()
-    counts[np.argsort(counts - quotas)[:remainder]] += 1
-    return counts
+# A GIF frame lasts a whole number of centiseconds, and browsers show one shorter than 20 ms
+# for 100 ms: fps above 50 played a GIF up to 10x slow. Every frame is held in memory, so
+# an animation has at most MAX_FPS x MAX_SECONDS of them.
+MAX_FPS = 50.0
+MAX_SECONDS = 60.0
 
 
-def frame_parameters(plan: Plan, frame_count: int,
-                     max_speed: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+def frame_parameters(plan: Plan, frame_count: int, max_speed: float = 1.0,
+                     max_acceleration: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """
-    Return (tau (F,), seconds (F,)) of the frames: time-uniform, every breakpoint kept.
+    Return (tau (F,), seconds (F,)) of frame_count frames evenly spaced in the plan's time.
 
-    Legs where nothing moves add no frame (their end looks like their start);
-    every other breakpoint parameter is a frame, and about frame_count frames
-    in all are spread over the legs in proportion to their durations.
+    The first frame is the start (tau 0), the last the end (tau 1); a plan in which
+    nothing moves has one frame. Each robot's trail runs through the breakpoints
+    (render_animation), so no frame needs to fall on one.
     """
-    stamps = plan.stamps(max_speed)
-    durations = np.diff(stamps)
-    moving = durations > 0
-    if not moving.any():
+    stamps = plan.stamps(max_speed, max_acceleration)
+    if not stamps[-1] > 0:
         return plan.times[:1].copy(), stamps[:1].copy()
-    budget = max(frame_count - 1 - int(moving.sum()), 0)
-    interior = np.zeros(durations.size, dtype=int)
-    interior[moving] = _allocate(durations[moving], budget)
-    taus = [plan.times[:1]]
-    for leg in np.flatnonzero(moving):
-        fractions = np.arange(1, interior[leg] + 2) / (interior[leg] + 1)
-        start, end = plan.times[leg], plan.times[leg + 1]
-        taus.append(start + (end - start) * fractions)
-    tau = np.concatenate(taus)
-    tau[-1] = plan.times[-1]
-    return tau, np.interp(tau, plan.times, stamps)
+    seconds = np.linspace(0.0, stamps[-1], max(2, frame_count))
+    # stamps do not decrease; a leg in which nothing moves (no time) is one point of it
+    tau = np.interp(seconds, stamps, plan.times)
+    tau[0], tau[-1] = plan.times[0], plan.times[-1]
+    return tau, seconds
 
 
 def _leg_label(plan, tau):
@@ -131,9 +122,10 @@ def _static_background(figure, dynamic):
 
 def render_animation(plan: Plan, path: str | os.PathLike[str], fps: float = 20,
                      seconds: float = 8.0, dpi: float = 80, title: str | None = None,
-                     max_speed: float = 1.0) -> str | os.PathLike[str]:
+                     max_speed: float = 1.0,
+                     max_acceleration: float = 0.0) -> str | os.PathLike[str]:
     """
-    Write the motion as an animated GIF at path (about fps * seconds frames); return path.
+    Write the motion as an animated GIF at path (fps * seconds frames); return path.
 
     The static picture is drawn once; each frame redraws only the trails, the
     robots and the title over it (blitting), then Pillow, matplotlib's own GIF
@@ -141,17 +133,26 @@ def render_animation(plan: Plan, path: str | os.PathLike[str], fps: float = 20,
     """
     if os.path.splitext(str(path))[1].lower() != '.gif':
         raise ValueError(f'render_animation writes GIF files; {path!r} does not end in .gif')
-    if not (fps > 0 and seconds > 0):
-        raise ValueError('fps and seconds must be positive')
-    tau, stamps = frame_parameters(plan, max(2, int(round(fps * seconds))), max_speed)
-    positions = plan.position(tau)
+    if not (0 < fps <= MAX_FPS and 0 < seconds <= MAX_SECONDS):
+        raise ValueError(f'fps must be in (0, {MAX_FPS:g}] (a GIF frame lasts at least '
+                         f'{1000 / MAX_FPS:g} ms) and seconds in (0, {MAX_SECONDS:g}]; got fps '
+                         f'{fps:g}, seconds {seconds:g}')
+    tau, stamps = frame_parameters(plan, int(round(fps * seconds)), max_speed,
+                                   max_acceleration)
+    # The trails: every breakpoint and every frame, in order; frame f ends at ends[f].
+    trail_tau = np.union1d(tau, plan.times)
+    ends = np.searchsorted(trail_tau, tau)
+    positions = plan.position(trail_tau)
     colours = robot_colours(positions.shape[1])
     figure, axes = plan_figure(plan, dpi=dpi, title=title, path_alpha=0.25, arrows=False)
     heading = plan_title(plan, title)
 
     def caption(frame: int) -> str:
         """Return the title of one frame: the plan's title, the time and the leg."""
-        return (f'{heading}\nt = {stamps[frame]:.2f} s at {max_speed:g} m/s '
+        limits = f'{max_speed:g} m/s'
+        if max_acceleration:
+            limits += f', {max_acceleration:g} m/s^2'
+        return (f'{heading}\nt = {stamps[frame]:.2f} s at {limits} '
                 f'(tau {tau[frame]:.3f}), {_leg_label(plan, tau[frame])}')
 
     heading_text = figure.suptitle(caption(0), fontsize=10)
@@ -167,7 +168,7 @@ def render_animation(plan: Plan, path: str | os.PathLike[str], fps: float = 20,
     for frame in range(tau.size):
         cast(FigureCanvasAgg, figure.canvas).restore_region(background)  # new_figure's Agg canvas
         for mover, points in movers:
-            mover.update(points[:frame + 1])
+            mover.update(points[:ends[frame] + 1])
         heading_text.set_text(caption(frame))
         for artist in dynamic:
             figure.draw_artist(artist)
