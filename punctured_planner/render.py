@@ -54,19 +54,22 @@ def _dpi(text):
     return value
 
 
-def _gif_path(text):
-    """Return text if it names a .gif file, or raise argparse.ArgumentTypeError."""
-    if not text.lower().endswith('.gif'):
-        raise argparse.ArgumentTypeError(f'{text!r}: the animation is written as a .gif file')
-    return text
+def _file_of(extension, what):
+    """Return an argparse type: a path ending in extension (what the file holds, for errors)."""
+    def path_of(text):
+        if not text.lower().endswith(extension):
+            raise argparse.ArgumentTypeError(f'{text!r}: {what} is written as a {extension} '
+                                             'file')
+        return text
+    return path_of
 
 
 def add_render_arguments(parser: argparse.ArgumentParser) -> argparse._ArgumentGroup:
     """Add --png, --dpi, --raw, --gif, --gif-fps, --gif-seconds and --gif-dpi to a parser."""
     group = parser.add_argument_group('pictures')
-    group.add_argument('--png', metavar='OUT.png',
+    group.add_argument('--png', metavar='OUT.png', type=_file_of('.png', 'the picture'),
                        help='draw the plan (paths, lanes, waypoints, domain, clearance)')
-    group.add_argument('--gif', metavar='OUT.gif', type=_gif_path,
+    group.add_argument('--gif', metavar='OUT.gif', type=_file_of('.gif', 'the animation'),
                        help='animate the synchronous motion of all robots')
     group.add_argument('--gif-fps', type=_at_most(MAX_FPS), default=20.0,
                        help='frames per second of the animation, at most 50 '

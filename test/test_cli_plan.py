@@ -71,6 +71,13 @@ def test_plan_refusals_and_exit_codes(capsys, tmp_path):
     assert code == 2 and data['error_code'] == 0, err
     assert 'punctured-planner: cannot write the outputs' in err and nowhere in err, err
     assert 'Traceback' not in err
+    # a service or node name rclpy refuses: a usage error naming it (a traceback, exit 1)
+    for argv in (['call', EXAMPLE, '--service', 'bad name!'],
+                 ['reset-obstacles', '--node', 'bad name!']):
+        with pytest.raises(SystemExit) as usage:
+            main(argv)
+        assert usage.value.code == 2
+        assert "'bad name!' is not a valid ROS name" in capsys.readouterr().err
 
 
 def test_plan_png_and_mcap_from_the_console_script(tmp_path, ros_env):

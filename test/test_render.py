@@ -69,6 +69,31 @@ def test_render_png_without_obstacles_or_second_robot(tmp_path):
     assert_picture(path, minimum_bytes=5000)
 
 
+def test_walls_are_drawn_and_a_large_fleets_legend_fits():
+    """
+    A plan below walls shows them; 40 robots get 11 named and one entry for the rest.
+
+    Before, the walls were not drawn, the legend named robots 0 - 38 and ran off the
+    figure (its layers' entries lost), and a plan without obstacles listed 'obstacle'.
+    """
+    from punctured_planner.viz.draw2d import legend_handles, WALL_COLOUR
+    from punctured_planner.viz.picture import plan_figure
+    rng = np.random.default_rng(3)
+    starts = np.c_[np.arange(40.0) * 0.6, np.zeros(40)]
+    goals = starts[rng.permutation(40)] + [0.0, 3.0]
+    workspace = Workspace([], dimension=2, bounds=[[-1.0, 25.0], [-20.0, 20.0]],
+                          variant='discs', robot_radius=0.1)
+    fleet = plan(workspace, [starts, goals])
+    labels = [h.get_label() for h in legend_handles(fleet, ['k'] * 40)]
+    assert labels[:12] == ['robot %d' % i for i in range(11)] + ['robots 11 - 39']
+    assert 'walls' in labels and 'obstacle' not in labels
+    axes = plan_figure(fleet)[1][0]
+    walls = [line for line in axes.get_lines() if line.get_color() == WALL_COLOUR]
+    assert len(walls) == 1
+    assert sorted(set(walls[0].get_xdata())) == [-1.0, 25.0]
+    assert sorted(set(walls[0].get_ydata())) == [-20.0, 20.0]
+
+
 def test_frame_parameters_are_evenly_spaced_in_the_plans_time():
     """Frames start at 0, end at 1 and are time-uniform, under an acceleration limit too."""
     p = example_plan()
@@ -213,3 +238,13 @@ def test_command_line_and_wiring(tmp_path, capsys):
     with pytest.raises(SystemExit):
         parser.parse_args(['--gif', 'out.mp4'])
     assert 'gif' in capsys.readouterr().err
+    # refused with the reason, where they gave PNG bytes named .jpg, or a traceback
+    for options, words in ((['--png', 'out.jpg'], 'written as a .png file'),
+                           (['--gif-fps', 'inf'], 'not a positive finite number'),
+                           (['--gif-fps', '100'], 'more than 50'),
+                           (['--gif-seconds', '61'], 'more than 60'),
+                           (['--dpi', '1e-3'], 'is not in [10, 1000]'),
+                           (['--gif-dpi', '1e5'], 'is not in [10, 1000]')):
+        with pytest.raises(SystemExit):
+            parser.parse_args(options)
+        assert words in capsys.readouterr().err, options

@@ -1,7 +1,8 @@
 """
 Draw a plan on 2-D axes through a PlaneView: the static picture and the animation background.
 
-Layers, bottom to top: e1 axis, dashed lanes, (optionally) the construction's
+Layers, bottom to top: the walls (workspace bounds, in the plane), e1 axis, dashed
+lanes, (optionally) the construction's
 unrefined paths dashed, robot paths with direction
 arrows, obstacles (and their discs), numbered waypoints C_1..C_n (and the
 robots' discs there), the certified closest approach (smallest gap with radii).
@@ -21,7 +22,26 @@ from ..core import Plan
 
 AXIS_COLOUR = '0.35'
 CLEARANCE_COLOUR = 'crimson'
+WALL_COLOUR = 'saddlebrown'
 ARROW_MIN_FRACTION = 0.03
+# Robots the legend names one by one; a larger fleet's legend ran off the figure (k = 40).
+LEGEND_ROBOTS = 12
+
+
+def wall_outline(plan: Plan) -> np.ndarray | None:
+    """Return the (5, 2) closed outline of the walls in the plane (None: none, or d != 2)."""
+    bounds = plan.workspace.bounds
+    if bounds is None or bounds.shape[0] != 2:
+        return None
+    (x0, x1), (y0, y1) = bounds
+    return np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1], [x0, y0]])
+
+
+def draw_walls(ax: Axes, plan: Plan) -> None:
+    """Draw the walls (workspace bounds) of a plane as a thick closed line."""
+    outline = wall_outline(plan)
+    if outline is not None:
+        ax.plot(outline[:, 0], outline[:, 1], color=WALL_COLOUR, lw=2.4, zorder=1)
 
 
 def draw_frame_lines(ax: Axes, plan: Plan, view: PlaneView,
@@ -94,11 +114,19 @@ def draw_closest_approach(ax: Axes, plan: Plan, view: PlaneView) -> None:
 
 def legend_handles(plan: Plan, colours: Sequence[ColorType],
                    waypoints_numbered: bool = True) -> list[Line2D]:
-    """Return proxy artists naming the robots and every layer of the picture."""
+    """Return proxy artists naming the robots (the first LEGEND_ROBOTS) and every layer."""
+    named = len(colours) if len(colours) <= LEGEND_ROBOTS else LEGEND_ROBOTS - 1
     handles = [Line2D([], [], color=colour, lw=2, label=f'robot {robot}')
-               for robot, colour in enumerate(colours)]
+               for robot, colour in enumerate(colours[:named])]
+    if named < len(colours):
+        handles.append(Line2D([], [], color='0.6', lw=2,
+                              label=f'robots {named} - {len(colours) - 1}'))
+    if plan.workspace.obstacle_count:
+        handles.append(Line2D([], [], ls='none', marker='X', ms=8, color='black',
+                              label='obstacle'))
+    if wall_outline(plan) is not None:
+        handles.append(Line2D([], [], color=WALL_COLOUR, lw=2.4, label='walls'))
     handles += [
-        Line2D([], [], ls='none', marker='X', ms=8, color='black', label='obstacle'),
         Line2D([], [], color=AXIS_COLOUR, lw=1.2, label='e1 axis'),
         Line2D([], [], color='0.5', ls='--', lw=0.8, label='lanes'),
     ]
@@ -115,6 +143,7 @@ def legend_handles(plan: Plan, colours: Sequence[ColorType],
 def draw_plan_2d(ax: Axes, plan: Plan, view: PlaneView, colours: Sequence[ColorType],
                  path_alpha: float = 1.0, arrows: bool = True, raw: bool = False) -> None:
     """Draw every layer of the plan on ax, axes labelled by the view (raw: Plan.raw dashed)."""
+    draw_walls(ax, plan)  # in the plane, where the view is (x, y) itself
     draw_frame_lines(ax, plan, view, colours)
     if raw and plan.raw is not None:
         draw_raw_paths(ax, plan, view, colours)
@@ -127,7 +156,8 @@ def draw_plan_2d(ax: Axes, plan: Plan, view: PlaneView, colours: Sequence[ColorT
     ax.set_aspect('equal', adjustable='box')
     ax.grid(True, lw=0.4, alpha=0.4)
     points = np.concatenate([view(plan.positions).reshape(-1, 2),
-                             view(plan.workspace.obstacles).reshape(-1, 2)])
+                             view(plan.workspace.obstacles).reshape(-1, 2)]
+                            + ([] if wall_outline(plan) is None else [wall_outline(plan)]))
     low, high = points.min(axis=0), points.max(axis=0)
     pad = 0.06 * max(float((high - low).max()), 1.0)
     ax.set_xlim(low[0] - pad, high[0] + pad)

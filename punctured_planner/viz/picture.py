@@ -49,7 +49,9 @@ def plan_title(plan: Plan, title: str | None = None) -> str:
     n, k, d = plan.configurations.shape
     r = plan.workspace.obstacle_count
     lines = [] if title is None else [str(title)]
-    lines.append(f'{k} robots, {r} obstacles in R^{d}, n = {n} configurations, '
+    robots = '1 robot' if k == 1 else f'{k} robots'
+    obstacles = '1 obstacle' if r == 1 else f'{r} obstacles'
+    lines.append(f'{robots}, {obstacles} in R^{d}, n = {n} configurations, '
                  f'variant {plan.variant!r}')
     lines.append(domain_text(plan))
     lines.append(clearance_text(plan))
