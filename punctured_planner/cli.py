@@ -321,22 +321,27 @@ def _plan(args):
         return EXIT_USAGE
     if outcome.exception is not None:
         print('punctured-planner: %r' % outcome.exception, file=sys.stderr)
+    # The files first: a reader of the answer that goes away (| head) ends the printing,
+    # and with it, before, the files asked for.
+    written: list = []
+    problem = None
+    if outcome.ok:
+        title = os.path.basename(args.request) if args.request != '-' else None
+        try:
+            written = render_outputs(args, outcome.planned().plan, title=title,
+                                     max_speed=outcome.max_speed,
+                                     max_acceleration=outcome.max_acceleration)
+            if args.mcap:
+                written.append(record_plan(args.mcap, outcome, settings))
+        except OSError as error:  # the plan is printed all the same
+            problem = error
     code = print_response(outcome.response, args.no_paths)
-    if not outcome.ok:
-        return code
-    title = os.path.basename(args.request) if args.request != '-' else None
-    try:
-        written = render_outputs(args, outcome.planned().plan, title=title,
-                                 max_speed=outcome.max_speed,
-                                 max_acceleration=outcome.max_acceleration)
-        if args.mcap:
-            written.append(record_plan(args.mcap, outcome, settings))
-    except OSError as error:  # the plan is printed; an output file could not be written
-        print('punctured-planner: cannot write the outputs (--png, --gif, --mcap): %s'
-              % error, file=sys.stderr)
-        return EXIT_USAGE
     for path in written:
         print('# wrote %s' % path, file=sys.stderr)
+    if problem is not None:
+        print('punctured-planner: cannot write the outputs (--png, --gif, --mcap): %s'
+              % problem, file=sys.stderr)
+        return EXIT_USAGE
     return code
 
 

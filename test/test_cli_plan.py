@@ -71,6 +71,12 @@ def test_plan_refusals_and_exit_codes(capsys, tmp_path):
     assert code == 2 and data['error_code'] == 0, err
     assert 'punctured-planner: cannot write the outputs' in err and nowhere in err, err
     assert 'Traceback' not in err
+    # one robot and no obstacle: nothing to meet, min_gap inf, written as YAML reads it
+    lonely = tmp_path / 'lonely.yaml'
+    lonely.write_text('configurations:\n- poses: [{position: {x: 0.0, y: 0.0, z: 0.0}}]\n'
+                      '- poses: [{position: {x: 1.0, y: 0.0, z: 0.0}}]\n', encoding='utf-8')
+    code, data, err = run(capsys, 'plan', str(lonely), '--no-paths')
+    assert code == 0 and data['min_gap'] == data['tracking_tolerance'] == float('inf'), data
     # a service or node name rclpy refuses: a usage error naming it (a traceback, exit 1)
     for argv in (['call', EXAMPLE, '--service', 'bad name!'],
                  ['reset-obstacles', '--node', 'bad name!']):
@@ -148,18 +154,21 @@ def test_plan_gif(capsys, tmp_path, option):
 
 
 def test_a_reader_that_goes_away_ends_the_output_quietly(tmp_path):
-    """`punctured-planner plan ... | head -3`: no BrokenPipeError traceback, exit 141."""
+    """`punctured-planner plan ... | head -3`: no traceback, exit 141, the files written."""
     with open(EXAMPLE, encoding='utf-8') as stream:
         request = yaml.safe_load(stream)
     request['samples_per_leg'] = 100  # megabytes of YAML: far more than a pipe holds
     path = tmp_path / 'long.yaml'
     path.write_text(yaml.safe_dump(request))
+    picture = tmp_path / 'long.png'
     process = subprocess.Popen([venv_script('punctured-planner'), 'plan', str(path),
-                                '--params', SCENARIO], stdout=subprocess.PIPE,
-                               stderr=subprocess.PIPE)
+                                '--params', SCENARIO, '--png', str(picture)],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     head = [process.stdout.readline() for _ in range(3)]
     process.stdout.close()  # as head does after three lines
     err = process.stderr.read().decode()
     assert process.wait(timeout=60) == 141, err
     assert head[0].startswith(b'error_code: 0')
     assert err == '', err
+    # the files asked for are written before the answer (before, never: the pipe ended it)
+    assert picture.read_bytes()[:8] == b'\x89PNG\r\n\x1a\n'

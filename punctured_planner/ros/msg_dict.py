@@ -9,7 +9,6 @@ plain data.
 
 import array
 import importlib
-import math
 import re
 from typing import Any
 
@@ -112,7 +111,12 @@ def fill_message(msg: Any, data: Any, where: str = 'request') -> Any:
 
 
 def message_to_dict(msg: Any) -> Any:
-    """Return ``msg`` as plain dicts, lists and scalars (YAML/JSON friendly)."""
+    """
+    Return ``msg`` as plain dicts, lists and scalars, for YAML.
+
+    Non-finite floats stay floats: YAML writes them .inf and .nan, which read back as
+    numbers (as text, 'inf' read back as a string).
+    """
     if _is_message(msg):
         return {name: message_to_dict(getattr(msg, name))
                 for name in msg.get_fields_and_field_types()}
@@ -120,8 +124,6 @@ def message_to_dict(msg: Any) -> Any:
         return [message_to_dict(item) for item in msg]
     if hasattr(msg, 'tolist'):
         return msg.tolist()
-    if isinstance(msg, float) and not math.isfinite(msg):
-        return str(msg)
     return msg
 
 
