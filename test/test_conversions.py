@@ -116,6 +116,20 @@ def test_markers_name_every_part():
     assert markers.markers[0].action == markers.markers[0].DELETEALL
     assert kinds.count('paths') == 4 and kinds.count('waypoints') == 3
     assert [m.text for m in markers.markers if m.ns == 'labels'] == ['a', 'b', 'c', 'd']
+    assert 'walls' not in kinds
+    # below walls, their box's edges: 4 in the plane (at plane_z), 12 in space
+    for bounds, edges in (([[-4.0, 4.0], [-3.0, 4.0]], 4),
+                          ([[-4.0, 4.0], [-3.0, 4.0], [-1.0, 1.0]], 12)):
+        d = len(bounds)
+        walled = core_plan(dimension=d, bounds=bounds)
+        wall, = [m for m in publications.plan_markers(walled, 'map', 0, 0.5).markers
+                 if m.ns == 'walls']
+        ends = np.array([(p.x, p.y, p.z) for p in wall.points]).reshape(-1, 2, 3)
+        assert len(ends) == edges
+        assert np.all((np.diff(ends, axis=1)[:, 0] != 0).sum(axis=1) == 1)  # along one axis
+        if d == 2:
+            assert np.all(ends[..., 2] == 0.5)
+        assert sorted(set(ends[..., 0].ravel())) == [-4.0, 4.0]
 
 
 def reference_paths(samples, orientations, frame_id, start_ns, plane_z=0.0):

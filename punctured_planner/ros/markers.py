@@ -7,7 +7,8 @@ lane, a LINE_LIST), ``paths`` (one LINE_STRIP per robot through every
 breakpoint, none twice, robot colours), ``waypoints`` (one SPHERE_LIST per
 configuration C_m) and ``labels`` (robot names at C_1); with radii also
 ``pillars`` (one cylinder of its diameter per obstacle) and ``bodies`` (the
-robots' discs at each C_m, translucent, of diameter 2 robot_radius).
+robots' discs at each C_m, translucent, of diameter 2 robot_radius); with
+workspace_bounds ``walls`` (the edges of their box, a LINE_LIST).
 """
 
 from collections.abc import Sequence
@@ -26,6 +27,7 @@ from .conversions import robot_names
 from .conversions import to_xyz
 from ..core import Plan
 from ..core import Workspace
+from ..core.walls import box_corners
 
 # Height (m) of the cylinder drawn for a pillar with a radius.
 PILLAR_HEIGHT = 1.0
@@ -75,6 +77,7 @@ def plan_markers(plan: Plan, frame_id: str, stamp_ns: int, plane_z: float = 0.0,
     names = names or robot_names((), positions.shape[1])
     markers = [Marker(header=drawing.header, action=Marker.DELETEALL)]
     markers += _obstacle_markers(drawing, plan.workspace)
+    markers += _wall_markers(drawing, plan.workspace)
     markers += _line_markers(drawing, plan, max_speed)
     markers += _waypoint_markers(drawing, plan, positions)
     markers += _label_markers(drawing, positions, names)
@@ -97,6 +100,19 @@ def _obstacle_markers(drawing: _Drawing, workspace: Workspace) -> list[Marker]:
             pillar.pose.position.z = float(obstacles[j, 2]) + 0.5 * PILLAR_HEIGHT
             markers.append(pillar)
     return markers
+
+
+def _wall_markers(drawing: _Drawing, workspace: Workspace) -> list[Marker]:
+    """Return the edges of the walls' box (none without workspace_bounds)."""
+    if workspace.bounds is None:
+        return []
+    corners = box_corners(workspace.bounds)
+    # an edge joins two corners that differ in one coordinate
+    first, second = np.nonzero(np.triu((corners[:, None] != corners[None]).sum(axis=2) == 1))
+    edges = to_xyz(np.stack([corners[first], corners[second]], axis=1),
+                   drawing.plane_z).reshape(-1, 3)
+    return [drawing.marker('walls', 0, Marker.LINE_LIST, _rgba(0.545, 0.271, 0.075, 1.0),
+                           0.08 * drawing.scale, edges)]
 
 
 def _line_markers(drawing: _Drawing, plan: Plan, max_speed: float) -> list[Marker]:
