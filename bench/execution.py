@@ -93,7 +93,7 @@ def simulate(the_plan, slow, late, shared_clock, **settings):
                                 np.tile([0.0, 0.0, 0.0, 1.0], positions.shape[:2] + (1,)),
                                 SPEED, ACCELERATION, the_plan.min_gap)
     bodies = Bodies(RADIUS, xyz(OBSTACLES), np.zeros(len(OBSTACLES)))
-    tolerance = tracking_tolerance(the_plan.min_gap)
+    tolerance = tracking_tolerance(the_plan.min_gap, the_plan.wall_gap)
     fleet = Fleet(positions[0], FleetSettings(
         bodies=bodies, speed_limit=SPEED, speed_factors=speed_factors(slow),
         latencies=np.where(np.arange(K) == late, LATENCY, 0.0), velocity_noise=NOISE,
@@ -383,7 +383,7 @@ def report(the_plan, rows, slow, late, shared, unshared, cancel, differential):
     from punctured_planner.execution import tracking_tolerance
     nominal = the_plan.duration(SPEED, ACCELERATION)
     at_slow = the_plan.duration(SPEED * 0.5, ACCELERATION)
-    tolerance = tracking_tolerance(the_plan.min_gap)
+    tolerance = tracking_tolerance(the_plan.min_gap, the_plan.wall_gap)
     bound = straight_bound(the_plan, slow)
     fleet_bound = float(straight_times(the_plan, slow).max())
     lines = [
@@ -518,7 +518,8 @@ def main(argv=None):
         print('DDS shared clock:', shared, flush=True)
         differential = dds_run(the_plan, 0, 1, True, 'diff', 'differential')
         print('DDS differential:', differential, flush=True)
-        print(differential_line(differential, shared, tracking_tolerance(the_plan.min_gap)))
+        print(differential_line(differential, shared,
+                                tracking_tolerance(the_plan.min_gap, the_plan.wall_gap)))
         return 0
     rows = sweep(the_plan, args.quick)
     for row in rows:

@@ -40,7 +40,6 @@ def node_values(parameters: dict, node: str, table) -> dict:
 def demo_scene():
     """Return (Reference, Bodies, tolerance, FleetSettings, ExecutionSettings) of make demo."""
     from punctured_planner.cli import offline_plan
-    from punctured_planner.execution import tracking_tolerance
     from punctured_planner.ros import conversions
     from punctured_planner.ros.msg_dict import fill_message
     from punctured_planner.ros.settings import EXECUTOR
@@ -63,7 +62,7 @@ def demo_scene():
     assert outcome.ok, outcome
     message = conversions.plan_message(outcome, planner)
     return (conversions.plan_reference(message), conversions.plan_bodies(message),
-            tracking_tolerance(message.min_gap), fleet.fleet(), executor.execution)
+            message.tracking_tolerance, fleet.fleet(), executor.execution)
 
 
 def demo_run(scene, adaptation: float, seed: int) -> dict:

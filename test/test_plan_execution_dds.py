@@ -324,10 +324,21 @@ def test_plan_to_motion_over_dds(graph):
     handle, feedback = graph.send(0)
     result = graph.result(handle, 30)
     assert result.error_code == result_type.CLOCK_HELD, result.error_msg + graph.logs()
-    assert 'hold_timeout 1 s' in result.error_msg and ': r1 ' in result.error_msg, \
-        result.error_msg
+    assert 'hold_timeout 1 s' in result.error_msg, result.error_msg
+    assert 'the clock waits for r1 ' in result.error_msg, result.error_msg
     assert client.spin_until(lambda: graph.speeds().max() < 1e-9, 1.5), graph.speeds()
+    # hold_timeout 0: the goal's first step, whose rate rises from 0 under the plan's
+    # acceleration limit, is no hold (before, every such goal ended CLOCK_HELD at once)
     graph.set_sim(speed_factors=[0.5, 1.0, 1.0])
+    graph.set_executor(hold_timeout=0.0)
+    graph.plan([START])
+    handle, feedback = graph.send(0)
+    ended = handle.get_result_async()
+    assert client.spin_until(lambda: ended.done() or (
+        feedback and feedback[-1][1].plan_time > 0.2), 20), graph.logs()
+    assert not ended.done(), ended.result().result.error_msg
+    handle.cancel_goal_async()
+    assert client.spin_until(ended.done, 10)
     graph.set_executor(hold_timeout=5.0)
 
     # goals that wait for a plan not out yet: a cancel ends one at once, a newer goal

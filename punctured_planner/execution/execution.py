@@ -125,6 +125,7 @@ class Step:
     orientations: np.ndarray    # (k, 4) references at plan_time
     velocities: np.ndarray      # (k, 3) commanded velocities, planning frame
     errors: np.ndarray          # (k,) tracking errors measured this step (m)
+    watched: np.ndarray         # (k,) what the clock slows and holds for, per robot (m)
     finished: bool
     differential: np.ndarray    # (k,) robots commanded by forward speed and yaw rate
     forward: np.ndarray         # (k,) differential robots' forward speeds (m/s), else 0
@@ -282,7 +283,8 @@ class Execution:
             np.linalg.norm(target - positions, axis=1) <= s.goal_tolerance))
         finished = self._settled(arrived, angles, dt) and arrived
         return Step(self.plan_time, rate, target, self.reference.orientation(self.plan_time),
-                    velocities, errors, finished, self.differential.copy(), forward, yaw_rates)
+                    velocities, errors, watched, finished, self.differential.copy(), forward,
+                    yaw_rates)
 
     def _measured(self, ages: np.ndarray | None) -> np.ndarray:
         """

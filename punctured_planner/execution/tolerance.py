@@ -17,7 +17,7 @@ robot can move in one control step and its command latency.
 import numpy as np
 
 
-def tracking_tolerance(min_gap: float, wall_gap: float = np.inf) -> float:
+def tracking_tolerance(min_gap: float, wall_gap: float) -> float:
     """
     Return delta = min(min_gap / 2, wall_gap): the largest safe deviation from a reference.
 

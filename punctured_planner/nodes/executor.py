@@ -26,8 +26,9 @@ itself, without waiting for the next tick), a newer goal (``PREEMPTED``),
 odometry in another frame (``FRAME_MISMATCH``), odometry stale for longer than
 ``hold_timeout`` (``ODOMETRY_LOST``: the clock held that long, every robot is
 sent zero velocity) or a clock held that long with every robot's odometry
-fresh (``CLOCK_HELD``: a robot that cannot follow). Odometry whose pose is not
-finite is ignored (warned). A stale robot gets zero velocity from
+fresh (``CLOCK_HELD``: a robot that cannot follow), one hold whatever its
+cause. Odometry whose position is not finite or whose orientation is no
+rotation is ignored (warned). A stale robot gets zero velocity from
 the first control step that finds its odometry older than ``odom_timeout``.
 Everything runs on one single-threaded executor, so callbacks never overlap.
 A goal still waiting for its plan ends at once when canceled (``CANCELED``),
@@ -104,8 +105,8 @@ class Run:
     started_ns: int = 0
     last_ns: int = 0
     stale: tuple = ()
-    stale_since: int | None = None  # ns: the first control step of the current hold
-    held_since: int | None = None  # ns: the first step of a hold with every robot heard
+    held_since: int | None = None  # ns: the first control step of the current hold
+    stale_in_hold: tuple = ()  # the robots whose odometry went stale during that hold
 
 
 @dataclass(eq=False)
@@ -214,7 +215,7 @@ class PlanExecutor(Node):
 
     def _on_odometry(self, name: str, msg: Odometry) -> None:
         """
-        Keep a robot's latest odometry; ignore one whose pose is not finite (warned).
+        Keep a robot's latest odometry; ignore one whose pose is no pose (warned).
 
         A NaN position made the clock jump to the plan's end and every robot get NaN
         velocities for good; ignored, it leaves the robot's last good odometry to age
@@ -403,12 +404,11 @@ class PlanExecutor(Node):
         execution = run.execution if run.execution is not None else self._start(run, state, now)
         if execution is None:
             return
-        if self._hold_expired(run, execution.plan_time, state, now):
-            return
-        step = execution.step((now - run.last_ns) * 1e-9, state.positions,
-                              state.stale_mask, state.orientations, state.ages)
+        dt = (now - run.last_ns) * 1e-9
+        step = execution.step(dt, state.positions, state.stale_mask, state.orientations,
+                              state.ages)
         run.last_ns = now
-        if self._held_too_long(run, step, state, now):
+        if self._hold_expired(run, step, state, now, dt):
             return
         self._log_stale(run, state, step.plan_time)
         self._publish_step(run, step, state, now)
@@ -453,49 +453,47 @@ class PlanExecutor(Node):
                                                 execution.reference.duration))
         return execution
 
-    def _hold_expired(self, run: Run, plan_time: float, state: FleetState, now: int) -> bool:
-        """End the goal ODOMETRY_LOST once the clock held hold_timeout for stale odometry."""
-        if not state.stale:
-            run.stale_since = None
-            return False
-        if run.stale_since is None:
-            run.stale_since = now
-        held = (now - run.stale_since) * 1e-9
-        timeout = self._settings.hold_timeout
-        if held < timeout:
-            return False
-        self._end(run, Result.ODOMETRY_LOST, 'odometry of %s stale (older than %g s; topics '
-                  '%s): the plan clock held %.3f s at plan time %.3f s, hold_timeout %g s; '
-                  'every robot was sent zero velocity'
-                  % (', '.join(state.stale), self._settings.odom_timeout,
-                     ', '.join(self.resolve_topic_name(n + '/odom') for n in state.stale),
-                     held, plan_time, timeout))
-        return True
-
-    def _held_too_long(self, run: Run, step: Step, state: FleetState, now: int) -> bool:
+    def _hold_expired(self, run: Run, step: Step, state: FleetState, now: int,
+                      dt: float) -> bool:
         """
-        End the goal CLOCK_HELD once the clock held hold_timeout with every robot heard.
+        End the goal once the clock held hold_timeout, every robot sent zero velocity.
 
-        A robot that cannot follow (stuck, blocked, stopped by its own e-stop) while its
-        odometry stays fresh held the whole fleet for good before: the clock waits for
-        it, and nothing else ends the goal.
+        One hold, whatever holds the clock (odometry stale, or a robot that does not
+        follow): ODOMETRY_LOST if some robot's odometry went stale during it, else
+        CLOCK_HELD, naming the robots the clock waits for. Two holds of their own let a
+        robot whose odometry flapped reset each the other's. The goal's first step
+        (dt = 0, its rate rising from 0) neither starts nor judges a hold.
         """
-        if step.rate > 0.0 or state.stale:
-            run.held_since = None
+        if step.rate > 0.0 and not state.stale:
+            run.held_since, run.stale_in_hold = None, ()
+            return False
+        if dt <= 0.0:
             return False
         if run.held_since is None:
             run.held_since = now
+        run.stale_in_hold = tuple(dict.fromkeys(run.stale_in_hold + state.stale))
         held = (now - run.held_since) * 1e-9
         timeout = self._settings.hold_timeout
         if held < timeout:
             return False
+        held_at = 'the plan clock held %.3f s at plan time %.3f s, hold_timeout %g s' % (
+            held, step.plan_time, timeout)
+        if run.stale_in_hold:
+            self._end(run, Result.ODOMETRY_LOST, 'odometry of %s stale (older than %g s; '
+                      'topics %s): %s; every robot was sent zero velocity'
+                      % (', '.join(run.stale_in_hold), self._settings.odom_timeout,
+                         ', '.join(self.resolve_topic_name(n + '/odom')
+                                   for n in run.stale_in_hold), held_at))
+            return True
         plan, limit = run.plan, run.plan.tolerance * self._settings.execution.hold_fraction
-        self._end(run, Result.CLOCK_HELD, 'the plan clock held %.3f s at plan time %.3f s '
-                  '(hold_timeout %g s), the odometry fresh: %s more than hold_fraction x the '
-                  'tracking tolerance (%.6g m) from the reference; every robot was sent zero '
-                  'velocity' % (held, step.plan_time, timeout, ', '.join(
-                      '%s %.3f m' % (plan.names[i], step.errors[i])
-                      for i in np.flatnonzero(step.errors >= limit)), limit))
+        waited = np.flatnonzero(step.watched >= limit)
+        if not waited.size:  # held by a turn's cap: the robot farthest behind
+            waited = np.array([int(np.argmax(step.watched))])
+        self._end(run, Result.CLOCK_HELD, '%s, the odometry fresh: the clock waits for %s '
+                  '(hold_fraction x the tracking tolerance: %.6g m); every robot was sent '
+                  'zero velocity' % (held_at, ', '.join(
+                      '%s %.3f m behind' % (plan.names[i], step.watched[i]) for i in waited),
+                      limit))
         return True
 
     def _log_stale(self, run: Run, state: FleetState, plan_time: float) -> None:

@@ -514,7 +514,9 @@ def plan_numbers(msg: Plan) -> None:
         if not (np.isfinite(value) and (value > low if strict else value >= low)):
             raise ValueError('plan %d: %s is %r, not a finite number %s 0'
                              % (msg.plan_id, name, value, '>' if strict else '>='))
-    if np.isnan(gap) or not tolerance <= 0.5 * gap:
+    if np.isnan(gap):
+        raise ValueError('plan %d: min_gap is not a number' % msg.plan_id)
+    if not tolerance <= 0.5 * gap:
         raise ValueError('plan %d: tracking_tolerance %r is more than min_gap / 2 (min_gap %r)'
                          % (msg.plan_id, tolerance, gap))
 

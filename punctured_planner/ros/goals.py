@@ -57,9 +57,12 @@ class PlanStore:
     A message on ``plan`` that is not a plan is ignored, and its id remembered with the
     reason: a goal naming it, or naming the latest plan (0) while it is the latest heard,
     ends NO_PLAN with that reason at once, never running an older plan in its place.
-    A planner numbers its plans 1, 2, ... from its start, so an id below the latest
-    heard is a restarted planner's: every id heard before is forgotten, and a goal for
-    the new planner's plan 2 waits for it instead of running the old planner's plan 2.
+    A planner numbers its plans 1, 2, ... from its start, so a plan whose id is below
+    the latest heard is a restarted planner's: every id heard before is forgotten, and
+    a goal for the new planner's plan 2 waits for it instead of running the old
+    planner's plan 2. (Not an ignored message, nor id 0: no planner's numbering.) Until
+    the new planner's first plan arrives, a goal for its plan 1 (or 0) still finds the
+    old one; plan_executor then runs it only with every robot at its start.
     """
 
     def __init__(self) -> None:
@@ -70,23 +73,18 @@ class PlanStore:
 
     def add(self, plan: KnownPlan) -> None:
         """Keep a plan (a plan id heard again replaces the old one and becomes the latest)."""
-        self._restarted(plan.plan_id)
+        if 0 < plan.plan_id < (self._latest or 0):  # a restarted planner: forget the old ids
+            self._plans.clear()
+            self._ignored.clear()
         _keep(self._plans, plan.plan_id, plan)
         self._ignored.pop(plan.plan_id, None)
         self._latest = plan.plan_id
 
     def ignore(self, plan_id: int, reason: str) -> None:
         """Note a message that is not a plan: its id is no plan now, and the latest heard."""
-        self._restarted(plan_id)
         _keep(self._ignored, plan_id, reason)
         self._plans.pop(plan_id, None)
         self._latest = plan_id
-
-    def _restarted(self, plan_id: int) -> None:
-        """Forget every id heard before when plan_id is below the latest (a new planner)."""
-        if self._latest is not None and plan_id < self._latest:
-            self._plans.clear()
-            self._ignored.clear()
 
     def heard(self, plan_id: int) -> bool:
         """Return whether a message named plan_id (0: any) is kept, a plan or an ignored one."""

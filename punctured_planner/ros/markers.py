@@ -107,10 +107,11 @@ def _wall_markers(drawing: _Drawing, workspace: Workspace) -> list[Marker]:
     if workspace.bounds is None:
         return []
     corners = box_corners(workspace.bounds)
-    # an edge joins two corners that differ in one coordinate
-    first, second = np.nonzero(np.triu((corners[:, None] != corners[None]).sum(axis=2) == 1))
-    edges = to_xyz(np.stack([corners[first], corners[second]], axis=1),
-                   drawing.plane_z).reshape(-1, 3)
+    # an edge joins two corners whose indices differ in one bit (box_corners)
+    index = np.arange(len(corners))
+    ends = [(i, i | bit) for bit in (1 << np.arange(corners.shape[1])).tolist()
+            for i in index[(index & bit) == 0].tolist()]
+    edges = to_xyz(corners[np.array(ends)], drawing.plane_z).reshape(-1, 3)
     return [drawing.marker('walls', 0, Marker.LINE_LIST, _rgba(0.545, 0.271, 0.075, 1.0),
                            0.08 * drawing.scale, edges)]
 
