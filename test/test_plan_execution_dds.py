@@ -15,6 +15,7 @@ ending on its goal facing the requested heading. The figures for 20 robots are
 in bench/.
 """
 
+import itertools
 import re
 import signal
 import time
@@ -426,58 +427,60 @@ def graph_vector(x, y):
     return Vector3(x=float(x), y=float(y))
 
 
-def test_a_goal_waiting_for_its_plan_ends_stopped_at_a_stop(ros_client, ros_env, tmp_path):
-    """SIGINT while a goal waits for its plan: the goal ends STOPPED, exit 0 (no result lost)."""
+_lone = itertools.count(1)
+
+
+@pytest.fixture
+def lone_executor(ros_client, ros_env, tmp_path):
+    """Start plan_executor alone in a namespace of its own; yield (process, action client)."""
     import os
 
     from punctured_planner_interfaces.action import ExecutePlan
     from rclpy.action import ActionClient
-    namespace = '/pp_exec_wait_%d' % os.getpid()
+    namespace = '/pp_exec_alone_%d_%d' % (os.getpid(), next(_lone))
     executor = NodeProcess([venv_script('plan_executor'), '--ros-args', '-r',
                             '__ns:=' + namespace], ros_env,
                            str(tmp_path / 'plan_executor.log'), namespace)
     action = ActionClient(ros_client.node, ExecutePlan, namespace + '/execute_plan')
     try:
         assert action.wait_for_server(timeout_sec=30), executor.log()
-        sent = action.send_goal_async(ExecutePlan.Goal(plan_id=99))
-        assert ros_client.spin_until(sent.done, 10) and sent.result().accepted
-        ros_client.spin_until(lambda: False, 0.3)
-        executor.proc.send_signal(signal.SIGINT)
-        result = sent.result().get_result_async()
-        assert ros_client.spin_until(result.done, 10), executor.log()
-        assert result.result().result.error_code == ExecutePlan.Result.STOPPED, executor.log()
-        assert 'waiting for plan 99' in result.result().result.error_msg
-        assert executor.proc.wait(timeout=10) == 0, executor.log()
-        assert 'Traceback' not in executor.log(), executor.log()
+        yield executor, action
     finally:
         action.destroy()
         executor.stop()
 
 
-def test_a_goal_for_a_plan_that_is_no_plan_ends_at_once_saying_why(
-        ros_client, ros_env, tmp_path):
+def test_a_goal_waiting_for_its_plan_ends_stopped_at_a_stop(ros_client, lone_executor):
+    """SIGINT while a goal waits for its plan: the goal ends STOPPED, exit 0 (no result lost)."""
+    from punctured_planner_interfaces.action import ExecutePlan
+    executor, action = lone_executor
+    sent = action.send_goal_async(ExecutePlan.Goal(plan_id=99))
+    assert ros_client.spin_until(sent.done, 10) and sent.result().accepted
+    ros_client.spin_until(lambda: False, 0.3)
+    executor.proc.send_signal(signal.SIGINT)
+    result = sent.result().get_result_async()
+    assert ros_client.spin_until(result.done, 10), executor.log()
+    assert result.result().result.error_code == ExecutePlan.Result.STOPPED, executor.log()
+    assert 'waiting for plan 99' in result.result().result.error_msg
+    assert executor.proc.wait(timeout=10) == 0, executor.log()
+    assert 'Traceback' not in executor.log(), executor.log()
+
+
+def test_a_goal_for_a_plan_that_is_no_plan_ends_at_once_saying_why(ros_client, lone_executor):
     """
     A goal waiting for plan 7 ends NO_PLAN as soon as plan 7 arrives malformed, with why.
 
     Before, it waited PLAN_WAIT_SEC and ended "plan 7 is not there" (the reason was only in
     the executor's log), and a goal for the latest plan ran an older one.
     """
-    import os
-
     from planner_helpers import faulty_plan
     from punctured_planner.nodes.executor import PLAN_WAIT_SEC
     from punctured_planner.ros.qos import LATCHED
     from punctured_planner_interfaces.action import ExecutePlan
     from punctured_planner_interfaces.msg import Plan
-    from rclpy.action import ActionClient
-    namespace = '/pp_exec_faulty_%d' % os.getpid()
-    executor = NodeProcess([venv_script('plan_executor'), '--ros-args', '-r',
-                            '__ns:=' + namespace], ros_env,
-                           str(tmp_path / 'plan_executor.log'), namespace)
-    action = ActionClient(ros_client.node, ExecutePlan, namespace + '/execute_plan')
-    publisher = ros_client.node.create_publisher(Plan, namespace + '/plan', LATCHED)
+    executor, action = lone_executor
+    publisher = ros_client.node.create_publisher(Plan, executor.name('plan'), LATCHED)
     try:
-        assert action.wait_for_server(timeout_sec=30), executor.log()
         sent = action.send_goal_async(ExecutePlan.Goal(plan_id=7))
         assert ros_client.spin_until(sent.done, 10) and sent.result().accepted
         ros_client.spin_until(lambda: False, 0.3)
@@ -492,8 +495,8 @@ def test_a_goal_for_a_plan_that_is_no_plan_ends_at_once_saying_why(
         assert ended.error_code == ExecutePlan.Result.NO_PLAN, ended
         assert waited < PLAN_WAIT_SEC, (waited, ended.error_msg)
         assert ended.error_msg.startswith(
-            'plan 7 on %s/plan was ignored: plan 7: the path of robot_2 has a non-finite '
-            'pose' % namespace), ended.error_msg
+            'plan 7 on %s was ignored: plan 7: the path of robot_2 has a non-finite pose'
+            % executor.name('plan')), ended.error_msg
         latest = action.send_goal_async(ExecutePlan.Goal(plan_id=0))
         assert ros_client.spin_until(latest.done, 10) and latest.result().accepted
         result = latest.result().get_result_async()
@@ -503,40 +506,25 @@ def test_a_goal_for_a_plan_that_is_no_plan_ends_at_once_saying_why(
         assert 'Traceback' not in executor.log(), executor.log()
     finally:
         ros_client.node.destroy_publisher(publisher)
-        action.destroy()
-        executor.stop()
 
 
-def test_a_result_asked_for_after_a_cancel_at_a_stop_is_answered(
-        ros_client, ros_env, tmp_path):
+def test_a_result_asked_for_after_a_cancel_at_a_stop_is_answered(ros_client, lone_executor):
     """
     A goal canceled and SIGINT at once, its result asked for after the cancel's reply: it comes.
 
     The stop's grace spin ran only while goals were unfinished; with the goal just ended
     by its cancel, the node went at once and the request was lost (1 in 3 runs).
     """
-    import os
-
     from punctured_planner_interfaces.action import ExecutePlan
-    from rclpy.action import ActionClient
-    namespace = '/pp_exec_cancel_stop_%d' % os.getpid()
-    executor = NodeProcess([venv_script('plan_executor'), '--ros-args', '-r',
-                            '__ns:=' + namespace], ros_env,
-                           str(tmp_path / 'plan_executor.log'), namespace)
-    action = ActionClient(ros_client.node, ExecutePlan, namespace + '/execute_plan')
-    try:
-        assert action.wait_for_server(timeout_sec=30), executor.log()
-        sent = action.send_goal_async(ExecutePlan.Goal(plan_id=99))
-        assert ros_client.spin_until(sent.done, 10) and sent.result().accepted
-        cancel = sent.result().cancel_goal_async()
-        executor.proc.send_signal(signal.SIGINT)
-        assert ros_client.spin_until(cancel.done, 10), executor.log()
-        result = sent.result().get_result_async()
-        assert ros_client.spin_until(result.done, 10), executor.log()
-        # whichever came first ended it: the cancel, or the stop
-        assert result.result().result.error_code in (ExecutePlan.Result.CANCELED,
-                                                     ExecutePlan.Result.STOPPED)
-        assert executor.proc.wait(timeout=10) == 0, executor.log()
-    finally:
-        action.destroy()
-        executor.stop()
+    executor, action = lone_executor
+    sent = action.send_goal_async(ExecutePlan.Goal(plan_id=99))
+    assert ros_client.spin_until(sent.done, 10) and sent.result().accepted
+    cancel = sent.result().cancel_goal_async()
+    executor.proc.send_signal(signal.SIGINT)
+    assert ros_client.spin_until(cancel.done, 10), executor.log()
+    result = sent.result().get_result_async()
+    assert ros_client.spin_until(result.done, 10), executor.log()
+    # whichever came first ended it: the cancel, or the stop
+    assert result.result().result.error_code in (ExecutePlan.Result.CANCELED,
+                                                 ExecutePlan.Result.STOPPED)
+    assert executor.proc.wait(timeout=10) == 0, executor.log()
