@@ -435,8 +435,8 @@ class PlanExecutor(Node):
                                                         for n in state.stale)))
             return None
         away = np.linalg.norm(state.positions - plan.reference.position(0.0), axis=1)
-        if (away > plan.tolerance).any():
-            far = np.flatnonzero(away > plan.tolerance)
+        far = np.flatnonzero(away > plan.tolerance)
+        if far.size:
             self._finish(run, Result.NOT_AT_START, '%s farther than the tracking tolerance '
                          '%.6g m from the start of plan %d (%s): the plan is certified from '
                          'its start only; plan again from where they are (use_current_state)'

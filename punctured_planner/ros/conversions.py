@@ -430,21 +430,21 @@ def plan_message(outcome: Outcome, settings: PlannerSettings) -> Plan:
     Return the punctured_planner_interfaces/Plan of a successful Outcome (topic ``plan``).
 
     The bodies are the workspace's (robot radius, obstacles and their radii); the
-    tracking tolerance is execution.tracking_tolerance(min_gap, wall_gap): the
-    walls are not in the message, their gap is in the tolerance.
+    tracking tolerance is the response's (fill_response: min_gap and the walls'
+    gap; the walls are not in the message, their gap is in the tolerance).
     """
     planned = outcome.planned()
     plan = planned.plan
     workspace = plan.workspace
     obstacles = [Point(x=x, y=y, z=z) for x, y, z in
                  to_xyz(workspace.obstacles, settings.plane_z).reshape(-1, 3).tolist()]
-    min_gap = float(plan.min_gap)
     return Plan(plan_id=int(outcome.plan_id), robot_names=list(planned.names),
                 paths=list(planned.paths), max_speed=float(outcome.max_speed),
                 max_acceleration=float(outcome.max_acceleration),
                 robot_radius=float(workspace.robot_radius), obstacles=obstacles,
                 obstacle_radii=np.asarray(workspace.obstacle_radii, dtype=float).tolist(),
-                min_gap=min_gap, tracking_tolerance=tracking_tolerance(min_gap, plan.wall_gap))
+                min_gap=float(plan.min_gap),
+                tracking_tolerance=float(outcome.response.tracking_tolerance))
 
 
 def path_arrays(path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -86,14 +86,18 @@ class PlanStore:
         self._plans.pop(plan_id, None)
         self._latest = plan_id
 
+    def _named(self, plan_id: int) -> int | None:
+        """Return the id a goal's plan_id names: itself, or for 0 the latest heard (None)."""
+        return self._latest if plan_id == 0 else plan_id
+
     def heard(self, plan_id: int) -> bool:
         """Return whether a message named plan_id (0: any) is kept, a plan or an ignored one."""
-        named = self._latest if plan_id == 0 else plan_id
+        named = self._named(plan_id)
         return named in self._plans or named in self._ignored
 
     def lookup(self, plan_id: int, topic: str) -> Lookup:
         """Return the plan a goal names (0: the latest) with NONE, NO_PLAN or UNSAFE_PLAN."""
-        named = self._latest if plan_id == 0 else plan_id
+        named = self._named(plan_id)
         if named is None:
             return Lookup(None, Result.NO_PLAN, 'no plan received yet on %s' % topic)
         if named in self._ignored:

@@ -37,11 +37,9 @@ def wall_outline(plan: Plan) -> np.ndarray | None:
     return np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1], [x0, y0]])
 
 
-def draw_walls(ax: Axes, plan: Plan) -> None:
-    """Draw the walls (workspace bounds) of a plane as a thick closed line."""
-    outline = wall_outline(plan)
-    if outline is not None:
-        ax.plot(outline[:, 0], outline[:, 1], color=WALL_COLOUR, lw=2.4, zorder=1)
+def draw_walls(ax: Axes, outline: np.ndarray) -> None:
+    """Draw the walls' outline (wall_outline) as a thick closed line."""
+    ax.plot(outline[:, 0], outline[:, 1], color=WALL_COLOUR, lw=2.4, zorder=1)
 
 
 def draw_frame_lines(ax: Axes, plan: Plan, view: PlaneView,
@@ -143,7 +141,9 @@ def legend_handles(plan: Plan, colours: Sequence[ColorType],
 def draw_plan_2d(ax: Axes, plan: Plan, view: PlaneView, colours: Sequence[ColorType],
                  path_alpha: float = 1.0, arrows: bool = True, raw: bool = False) -> None:
     """Draw every layer of the plan on ax, axes labelled by the view (raw: Plan.raw dashed)."""
-    draw_walls(ax, plan)  # in the plane, where the view is (x, y) itself
+    outline = wall_outline(plan)  # in the plane, where the view is (x, y) itself
+    if outline is not None:
+        draw_walls(ax, outline)
     draw_frame_lines(ax, plan, view, colours)
     if raw and plan.raw is not None:
         draw_raw_paths(ax, plan, view, colours)
@@ -157,7 +157,7 @@ def draw_plan_2d(ax: Axes, plan: Plan, view: PlaneView, colours: Sequence[ColorT
     ax.grid(True, lw=0.4, alpha=0.4)
     points = np.concatenate([view(plan.positions).reshape(-1, 2),
                              view(plan.workspace.obstacles).reshape(-1, 2)]
-                            + ([] if wall_outline(plan) is None else [wall_outline(plan)]))
+                            + ([] if outline is None else [outline]))
     low, high = points.min(axis=0), points.max(axis=0)
     pad = 0.06 * max(float((high - low).max()), 1.0)
     ax.set_xlim(low[0] - pad, high[0] + pad)
