@@ -231,7 +231,7 @@ def test_errors_carry_their_culprits_and_are_worded_by_the_layer_that_answers():
     assert error.obstacles == (0, 2) and error.obstacle == 0
     assert str(error) == 'OBSTACLES_DEGENERATE: obstacles 0 and 2 are at the same point'
     named = ObstacleSet(np.c_[points, np.zeros(3)], source='/fleet/obstacles')
-    assert error.describe(ObstacleNames(named)) == (
+    assert error.describe(ObstacleNames(named.name)) == (
         'obstacle 0 at (0, 1, 0) (from topic /fleet/obstacles) and obstacle 2 at (0, 1, 0) '
         '(from topic /fleet/obstacles) are at the same point')
 

@@ -63,10 +63,14 @@ DRIVES = (HOLONOMIC, DIFFERENTIAL)
 
 @dataclass(frozen=True)
 class ExecutionSettings:
-    """The tracking law's settings (the executor node's parameters of the same names)."""
+    """
+    The tracking law's settings (the executor node's parameters of the same names).
+
+    The defaults are the parameters' (ros/settings.py takes them from here).
+    """
 
     gain: float = 2.0
-    speed_limit: float = 1.0
+    speed_limit: float = 0.5
     slow_fraction: float = 0.3
     hold_fraction: float = 0.6
     goal_tolerance: float = 0.01

@@ -209,7 +209,7 @@ class PlannerNode(Node):
         except PlanningError as error:
             self.get_logger().warning('refused %s: %s: %s; keeping %s' % (
                 obstacles.describe(), error.code.name,
-                error.describe(ObstacleNames(obstacles)), previous.describe()))
+                error.describe(ObstacleNames(obstacles.name)), previous.describe()))
             return
         with self._lock:
             self._obstacles = obstacles

@@ -1,11 +1,17 @@
 """
-nav_msgs/Path messages serialised with numpy, to the byte as rmw_fastrtps writes them.
+A plan's nav_msgs/Paths, and the same serialised with numpy as rmw_fastrtps writes them.
 
-The planner publishes every robot's Path as these bytes (built once with the
-response's Paths, :func:`punctured_planner.ros.conversions.plan_to_paths`);
-test_conversions compares them with ``rclpy.serialization.serialize_message``.
+The planner publishes every robot's Path as these bytes (:class:`Paths`, built
+once with the response's Paths by
+:func:`punctured_planner.ros.conversions.plan_to_paths`); test_conversions
+compares them with ``rclpy.serialization.serialize_message``.
 """
 
+from collections.abc import Iterable
+from dataclasses import dataclass
+from functools import cached_property
+
+from nav_msgs.msg import Path
 import numpy as np
 
 # CDR as rmw_fastrtps writes it: encapsulation header (little endian), then the fields,
@@ -56,3 +62,37 @@ def serialized_paths(frame_id: str, start_ns: int, stamps: np.ndarray,
         body[:, start:start + elements.shape[1] * dtype.itemsize] = elements.view(
             np.uint8).reshape(robots, -1)
     return [_CDR_HEADER + row.tobytes() for row in body]
+
+
+@dataclass(frozen=True)
+class PathValues:
+    """The values of a plan's Paths as arrays: what their CDR bytes are built from."""
+
+    frame_id: str
+    start_ns: int            # the stamp of the first pose
+    stamps: np.ndarray       # (M,) ns, one per pose
+    xyz: np.ndarray          # (k, M, 3) positions
+    quaternions: np.ndarray  # (k, n, 4) orientations at the waypoints
+    held: np.ndarray         # (M,) pose i holds quaternions[:, held[i]]
+
+
+class Paths(list):
+    """
+    The robots' nav_msgs/Paths, and ``serialized``: the same Paths as CDR bytes (topics).
+
+    The bytes are built on first use: only the topics need them, and the node
+    publishes after the reply (msg_docs/topics.md), so the reply does not wait for them.
+    """
+
+    def __init__(self, paths: Iterable[Path], values: PathValues) -> None:
+        """Keep the Paths and the values their bytes are built from."""
+        super().__init__(paths)
+        self.values = values
+
+    @cached_property
+    def serialized(self) -> list[bytes]:
+        """Return each Path as CDR bytes (:func:`serialized_paths`)."""
+        values = self.values
+        return serialized_paths(values.frame_id, values.start_ns, values.stamps,
+                                np.concatenate([values.xyz, values.quaternions[:, values.held]],
+                                               axis=-1))

@@ -35,8 +35,6 @@ Conventions:
 
 from collections.abc import Iterable
 from collections.abc import Sequence
-from dataclasses import dataclass
-from functools import cached_property
 
 from builtin_interfaces.msg import Duration
 from builtin_interfaces.msg import Time
@@ -56,7 +54,8 @@ from punctured_planner_interfaces.srv import PlanSequence
 from std_msgs.msg import Header
 from std_msgs.msg import UInt32
 
-from .cdr import serialized_paths
+from .cdr import Paths
+from .cdr import PathValues
 from .goals import KnownPlan
 from .parameters import ros_names
 from .settings import PlannerSettings
@@ -215,40 +214,6 @@ def stamps_ns(start_ns: int, seconds: npt.ArrayLike) -> np.ndarray:
     offsets = np.rint(np.asarray(seconds) * 1e9).astype(np.int64)
     steps = np.arange(offsets.size, dtype=np.int64)
     return int(start_ns) + np.maximum.accumulate(offsets - steps) + steps
-
-
-@dataclass(frozen=True)
-class PathValues:
-    """The values of a plan's Paths as arrays: what their CDR bytes are built from."""
-
-    frame_id: str
-    start_ns: int            # the stamp of the first pose
-    stamps: np.ndarray       # (M,) ns, one per pose
-    xyz: np.ndarray          # (k, M, 3) positions
-    quaternions: np.ndarray  # (k, n, 4) orientations at the waypoints
-    held: np.ndarray         # (M,) pose i holds quaternions[:, held[i]]
-
-
-class Paths(list):
-    """
-    The robots' nav_msgs/Paths, and ``serialized``: the same Paths as CDR bytes (topics).
-
-    The bytes are built on first use: only the topics need them, and the node
-    publishes after the reply (msg_docs/topics.md), so the reply does not wait for them.
-    """
-
-    def __init__(self, paths: Iterable[Path], values: PathValues) -> None:
-        """Keep the Paths and the values their bytes are built from."""
-        super().__init__(paths)
-        self.values = values
-
-    @cached_property
-    def serialized(self) -> list[bytes]:
-        """Return each Path as CDR bytes (:func:`~punctured_planner.ros.cdr.serialized_paths`)."""
-        values = self.values
-        return serialized_paths(values.frame_id, values.start_ns, values.stamps,
-                                np.concatenate([values.xyz, values.quaternions[:, values.held]],
-                                               axis=-1))
 
 
 def plan_to_paths(samples: core.Samples, orientations: npt.ArrayLike, frame_id: str,

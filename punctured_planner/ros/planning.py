@@ -94,7 +94,7 @@ class PlanSequenceHandler:
             # use_current_state) all the same.
             label = (gathered.label if gathered is not None else functools.partial(
                 checks.configuration_label, checks.requested_state(request, snapshot)))
-            names = RequestNames(snapshot.obstacles, label,
+            names = RequestNames(snapshot.obstacles.name, label,
                                  checked.planned if checked is not None else None)
             conversions.fill_error(response, error.code, error.describe(names),
                                    time.perf_counter() - started, error.clearance, error.gap)
@@ -144,7 +144,7 @@ class PlanSequenceHandler:
                     if changed & {'obstacles', 'obstacle_radius'} else '')
             raise ValueError('%s with %s: %s%s' % (
                 error.code.name, obstacles.describe(),
-                error.describe(ObstacleNames(obstacles)), hint)) from None
+                error.describe(ObstacleNames(obstacles.name)), hint)) from None
 
     def check_workspace(self, settings: PlannerSettings, obstacles: ObstacleSet) -> None:
         """

@@ -214,7 +214,7 @@ DRIVE = Spec(
     'per robot in robot order.', check=_drives,
     prose="'holonomic' or 'differential': one, or one per robot")
 YAW_RATE_LIMIT = Spec(
-    'yaw_rate_limit', 'double', 1.0,
+    'yaw_rate_limit', 'double', ExecutionSettings.yaw_rate_limit,
     "Differential robots' yaw-rate limit (rad/s).", low=1e-6, high=1e3)
 
 
@@ -232,22 +232,22 @@ class ExecutorSettings:
         'Rate of the control loop: clock step, commands, references, feedback (Hz).',
         low=1.0, high=1000.0, read_only=True).field()
     gain: float = Spec(
-        'gain', 'double', 2.0,
+        'gain', 'double', ExecutionSettings.gain,
         'Feedback gain on the position error (1/s).', low=0.0, high=100.0).field()
     speed_limit: float = Spec(
-        'speed_limit', 'double', 0.5,
+        'speed_limit', 'double', ExecutionSettings.speed_limit,
         "The robots' speed limit (m/s): commands are saturated at it.",
         low=1e-6, high=1e3).field()
     slow_fraction: float = Spec(
-        'slow_fraction', 'double', 0.3,
+        'slow_fraction', 'double', ExecutionSettings.slow_fraction,
         'The clock runs at full rate while every tracking error is at most this fraction '
         'of the tolerance, slower above.', low=0.0, high=1.0).field()
     hold_fraction: float = Spec(
-        'hold_fraction', 'double', 0.6,
+        'hold_fraction', 'double', ExecutionSettings.hold_fraction,
         'The clock holds while some tracking error is at least this fraction of the '
         'tolerance (above slow_fraction).', low=0.0, high=1.0).field()
     goal_tolerance: float = Spec(
-        'goal_tolerance', 'double', 0.01,
+        'goal_tolerance', 'double', ExecutionSettings.goal_tolerance,
         'A goal succeeds once the clock reached the end and every robot is this close to '
         'its last configuration (m).', low=1e-6, high=1e3).field()
     odom_timeout: float = Spec(
@@ -277,7 +277,7 @@ class ExecutorSettings:
         "orientation of its last pose (the request's; identity faces +x); 'none': it "
         'stops facing where it arrived.', choices=('request', 'none')).field()
     feedforward_adaptation: float = Spec(
-        'feedforward_adaptation', 'double', 3.0,
+        'feedforward_adaptation', 'double', ExecutionSettings.feedforward_adaptation,
         "How fast (1/s) each robot's feed-forward gain grows while it lags behind its "
         'moving reference by more than slow_fraction of the tolerance (and falls back '
         'toward 1 while it is ahead), up to 4: a robot that achieves a fraction f of its '
@@ -339,7 +339,7 @@ class FleetSimSettings:
     obstacles: tuple = OBSTACLES.field()
     obstacle_radius: tuple = OBSTACLE_RADIUS.field()
     speed_limit: float = Spec(
-        'speed_limit', 'double', 0.5,
+        'speed_limit', 'double', FleetSettings.speed_limit,
         'Largest speed a robot executes (m/s); faster commands are scaled down.',
         low=0.0, high=1e3).field()
     speed_factors: tuple = Spec(
@@ -352,18 +352,18 @@ class FleetSimSettings:
         'Per robot, the delay before a command takes effect (s); empty: all 0.',
         check=within(0.0, 10.0), prose='empty or one per robot, in [0, 10]').field()
     velocity_noise: float = Spec(
-        'velocity_noise', 'double', 0.0,
+        'velocity_noise', 'double', FleetSettings.velocity_noise,
         'Relative velocity noise: each axis of the velocity is multiplied by 1 + '
         'velocity_noise x N(0, 1) every step.', low=0.0, high=10.0).field()
     command_timeout: float = Spec(
-        'command_timeout', 'double', 0.5,
+        'command_timeout', 'double', FleetSettings.command_timeout,
         'A robot whose last command took effect longer ago than this stops (s).',
         low=1e-3, high=1e3).field()
     rate: float = Spec(
         'rate', 'double', 20.0,
         'Simulation and publishing rate (Hz).', low=1.0, high=1000.0, read_only=True).field()
     seed: int = Spec(
-        'seed', 'integer', 0,
+        'seed', 'integer', FleetSettings.seed,
         'Seed of the velocity noise.', low=0, high=2 ** 31 - 1, read_only=True).field()
     muted_robots: tuple = Spec(
         'muted_robots', 'string_array', [],
@@ -379,7 +379,7 @@ class FleetSimSettings:
         'toward the command at most this fast; 0 or empty: at once.',
         check=within(0.0, 1e3), prose='empty, one, or one per robot, in [0, 1000]').field()
     max_yaw_acceleration: float = Spec(
-        'max_yaw_acceleration', 'double', 0.0,
+        'max_yaw_acceleration', 'double', FleetSettings.max_yaw_acceleration,
         "Differential robots' yaw acceleration limit (rad/s^2); 0: at once.",
         low=0.0, high=1e4).field()
 

@@ -8,16 +8,13 @@ request is planned against, and the :class:`Outcome` of a request.
 
 from dataclasses import dataclass
 from typing import Any
-from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .cdr import Paths
 from .settings import PlannerSettings
 from ..core import ErrorCode
 from ..core import Plan
-
-if TYPE_CHECKING:  # conversions imports this module
-    from .conversions import Paths
 
 
 def format_stamp(ns: int) -> str:
@@ -99,7 +96,7 @@ class Planned:
     """What a planned request made: the core's plan, the robots' Paths and their names."""
 
     plan: Plan
-    paths: 'Paths'
+    paths: Paths
     names: list[str]
 
 
@@ -109,7 +106,7 @@ class Outcome:
 
     response: Any
     plan: Plan | None = None
-    paths: 'Paths | None' = None
+    paths: Paths | None = None
     names: list[str] | None = None
     start_ns: int = 0
     max_speed: float = 0.0

@@ -12,13 +12,9 @@ configurations it plans; ``planned`` maps them back to the request's.
 
 from typing import Callable
 from typing import Sequence
-from typing import TYPE_CHECKING
 
 from ..core.errors import Names
 from ..core.errors import Wall
-
-if TYPE_CHECKING:  # settings imports this module, and snapshot imports settings
-    from .snapshot import ObstacleSet
 
 
 class WallNames(Names):
@@ -30,28 +26,33 @@ class WallNames(Names):
 
 
 class ObstacleNames(WallNames):
-    """Obstacles by index, position and source (the node's obstacle set); walls by entry."""
+    """
+    Obstacles by index, position and source (the node's obstacle set); walls by entry.
 
-    def __init__(self, obstacles: 'ObstacleSet') -> None:
-        """Name the obstacles of ``obstacles``."""
-        self._obstacles = obstacles
+    name(j) words obstacle j: the node's :meth:`ObstacleSet.name
+    <punctured_planner.ros.snapshot.ObstacleSet.name>`.
+    """
+
+    def __init__(self, name: Callable[[int], str]) -> None:
+        """Name each obstacle j as name(j)."""
+        self._name = name
 
     def obstacle(self, j: int, point: object = None) -> str:
         """Return 'obstacle j at (x, y, z) (from <source>)'."""
-        return self._obstacles.name(j)
+        return self._name(j)
 
     def obstacles(self, indices: tuple[int, ...]) -> str:
         """Return the names of several obstacles, joined by 'and'."""
-        return ' and '.join(self._obstacles.name(j) for j in indices)
+        return ' and '.join(self._name(j) for j in indices)
 
 
 class RequestNames(ObstacleNames):
     """Configurations by their label in the request, obstacles as :class:`ObstacleNames`."""
 
-    def __init__(self, obstacles: 'ObstacleSet', label: Callable[[int], str],
+    def __init__(self, name: Callable[[int], str], label: Callable[[int], str],
                  planned: Sequence[int] | None = None) -> None:
         """label(m) names request configuration m; planned[i] is the i-th planned one's m."""
-        super().__init__(obstacles)
+        super().__init__(name)
         self._label = label
         self._planned = planned
 

@@ -31,6 +31,7 @@ from dataclasses import field
 import numpy as np
 
 from ..execution.bodies import Bodies
+from ..execution.execution import ExecutionSettings
 from ..execution.execution import saturate
 from ..execution.unicycle import headings
 from ..execution.unicycle import wrap
@@ -38,17 +39,21 @@ from ..execution.unicycle import wrap
 
 @dataclass(frozen=True)
 class FleetSettings:
-    """The fleet's physics (the fleet_sim node's parameters of the same names)."""
+    """
+    The fleet's physics (the fleet_sim node's parameters of the same names).
+
+    The defaults are the parameters' (ros/settings.py takes them from here).
+    """
 
     bodies: Bodies = field(default_factory=Bodies)
-    speed_limit: float = 1.0
+    speed_limit: float = 0.5
     speed_factors: np.ndarray | None = None   # (k,), None: all 1
     latencies: np.ndarray | None = None       # (k,) seconds, None: all 0
     velocity_noise: float = 0.0
     command_timeout: float = 0.5
     seed: int = 0
     differential: np.ndarray | None = None    # (k,) bool, None: all holonomic
-    yaw_rate_limit: float = 1.0               # rad/s, differential robots
+    yaw_rate_limit: float = ExecutionSettings.yaw_rate_limit  # rad/s, differential robots
     # m/s^2 on the commanded velocity: one value or (k,), one per robot; 0: unlimited
     max_acceleration: float | np.ndarray = 0.0
     max_yaw_acceleration: float = 0.0         # rad/s^2, differential robots; 0: unlimited
