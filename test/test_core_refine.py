@@ -16,8 +16,9 @@ from hypothesis import assume, example, given, HealthCheck, settings, strategies
 import numpy as np
 from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
 from punctured_planner.core.certificate import certify_bodies, RELATIVE_RESOLUTION
+from punctured_planner.core.pairs import point_radii
 from punctured_planner.core.plan import Plan
-from punctured_planner.core.refine import Bodies, refine
+from punctured_planner.core.refine import Constraints, refine
 from punctured_planner.core.walls import smallest_leg_slack
 import pytest
 
@@ -148,11 +149,11 @@ def refined_with_walls(raw, bounds):
     """Return raw's Plan refined by core.refine with walls at bounds (None for none)."""
     workspace = raw.workspace
     k = raw.positions.shape[1]
-    radii = np.concatenate([np.full(k, workspace.robot_radius), workspace.obstacle_radii])
+    radii = point_radii(k, workspace.robot_radius, workspace.obstacle_radii)
     rounding = RELATIVE_RESOLUTION * float(np.abs(raw.positions).max(initial=1.0))
     return Plan.refined(raw, refine(raw.times, raw.positions, raw.waypoint_indices,
-                                    Bodies(workspace.obstacles, radii, raw.min_gap, rounding,
-                                           bounds)))
+                                    Constraints(workspace.obstacles, radii, raw.min_gap,
+                                                rounding, bounds)))
 
 
 def wall_bounds(raw, share, seed):

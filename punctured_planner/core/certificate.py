@@ -23,7 +23,7 @@ from operator import attrgetter
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .pairs import point_pairs, with_obstacles
+from .pairs import point_pairs, PointPair, with_obstacles
 
 # A clearance is trusted only above this fraction of the coordinate scale: the
 # breakpoints and the closed form each round to a few ulps of the largest
@@ -417,10 +417,8 @@ def _clearance(found, times, k, exponent, resolution):
     leg, fraction = found.leg, found.fraction
     value = float(np.ldexp(found.value, exponent))
     tau = float(times[leg] + fraction * (times[leg + 1] - times[leg]))
-    if found.second >= k:
-        return Clearance(value, 'obstacle', (found.first, found.second - k), leg, fraction,
-                         tau, resolution)
-    return Clearance(value, 'robots', (found.first, found.second), leg, fraction, tau,
+    pair = PointPair.from_points(found.first, found.second, k)
+    return Clearance(value, pair.kind, (pair.first, pair.second), leg, fraction, tau,
                      resolution)
 
 

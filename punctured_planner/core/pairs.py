@@ -1,5 +1,10 @@
-"""Index arrays of point pairs, built once per size (they sit on every hot path)."""
+"""
+The points of a configuration and their pairs: robots 0 .. k - 1, then obstacle j as k + j.
 
+Index arrays of point pairs are built once per size (they sit on every hot path).
+"""
+
+from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
@@ -36,6 +41,29 @@ def pair_difference_matrix(robot_count: int, obstacle_count: int = 0) -> np.ndar
     matrix[np.arange(a.size), b] = -1.0
     matrix.flags.writeable = False
     return matrix
+
+
+def point_radii(robot_count: int, robot_radius: float,
+                obstacle_radii: np.ndarray) -> np.ndarray:
+    """Return the (k + r,) radii of the points: each robot's robot_radius, then the obstacles'."""
+    return np.concatenate([np.full(robot_count, float(robot_radius)),
+                           np.asarray(obstacle_radii, dtype=float)])
+
+
+@dataclass(frozen=True)
+class PointPair:
+    """A pair of points as its culprits: kind 'robots' (two robots) or 'obstacle' (robot, j)."""
+
+    kind: str
+    first: int
+    second: int
+
+    @classmethod
+    def from_points(cls, first: int, second: int, robot_count: int) -> 'PointPair':
+        """Return the pair of points first < second, the second k + j for obstacle j."""
+        if second >= robot_count:
+            return cls('obstacle', int(first), int(second) - robot_count)
+        return cls('robots', int(first), int(second))
 
 
 def with_obstacles(configurations: np.ndarray, obstacles: np.ndarray) -> np.ndarray:

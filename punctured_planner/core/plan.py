@@ -25,7 +25,8 @@ from .certificate import certify, certify_bodies, Clearance, RELATIVE_RESOLUTION
 from .complexity import domain_range, sequential_complexity
 from .deformations import desingularize, desingularizing_shift, spread
 from .errors import ErrorCode, PlanningError
-from .refine import block_count, Bodies, refine as refine_motion, Refinement
+from .pairs import point_radii
+from .refine import block_count, Constraints, refine as refine_motion, Refinement
 from .sections import compose, lane_heights, SCHEDULES, segment_times
 from .space import Workspace
 from .strata import epsilon, projection_count, projection_gaps
@@ -143,7 +144,7 @@ class Plan:
         """Return (clearance, gap) with bodies, both from one pass over pairs and legs."""
         workspace = self.workspace
         k = self.positions.shape[1]
-        radii = np.concatenate([np.full(k, workspace.robot_radius), workspace.obstacle_radii])
+        radii = point_radii(k, workspace.robot_radius, workspace.obstacle_radii)
         return certify_bodies(self.times, self.positions, workspace.obstacles, radii)
 
     @property
@@ -382,11 +383,12 @@ def _refined(raw):
         return raw
     workspace = raw.workspace
     k = raw.positions.shape[1]
-    radii = np.concatenate([np.full(k, workspace.robot_radius), workspace.obstacle_radii])
+    radii = point_radii(k, workspace.robot_radius, workspace.obstacle_radii)
     rounding = RELATIVE_RESOLUTION * float(np.abs(raw.positions).max(initial=1.0))
-    bodies = Bodies(workspace.obstacles, radii, raw.min_gap, rounding, workspace.bounds)
+    constraints = Constraints(workspace.obstacles, radii, raw.min_gap, rounding,
+                              workspace.bounds)
     return Plan.refined(raw, refine_motion(raw.times, raw.positions, raw.waypoint_indices,
-                                           bodies))
+                                           constraints))
 
 
 def _check_required_clearance(result: Plan) -> None:

@@ -27,7 +27,7 @@ the checked set; every quantity is a continuous function of the input, and
 the number of blocks, sweeps and knots is fixed, so the map stays continuous
 on every domain (doc/design.md section 14).
 
-With walls (Bodies.bounds) each robot's change along each axis is kept within
+With walls (Constraints.bounds) each robot's change along each axis is kept within
 half its slack to the wall behind it (0 where it is beyond that wall), and
 where a knot's hat reaches beyond a wall the block starts from a pull
 inwards: the motion never reaches farther beyond a wall than the
@@ -85,7 +85,7 @@ _FILTER_ENTRIES = 1 << 17
 
 
 @dataclass(frozen=True, eq=False)
-class Bodies:
+class Constraints:
     """
     What the gaps are measured against: pillars (r, d), radii (k + r,), the margin g0.
 
@@ -389,9 +389,9 @@ def _interval_minima(planes, knots, pillars=None, offsets=None):
     return _pair_minimum(minima, k)
 
 
-def _pillar_offsets(bodies, k):
+def _pillar_offsets(constraints, k):
     """Return (k, r) what each robot-pillar gap takes from the distance: both radii."""
-    return bodies.radii[:k, None] + bodies.radii[None, k:]
+    return constraints.radii[:k, None] + constraints.radii[None, k:]
 
 
 @dataclass(frozen=True, eq=False)
@@ -409,16 +409,17 @@ class _Nearest:
     pillars: np.ndarray | None
 
     @classmethod
-    def of(cls, motion: np.ndarray, knots: _Knots, bodies: Bodies) -> '_Nearest':
+    def of(cls, motion: np.ndarray, knots: _Knots, constraints: Constraints) -> '_Nearest':
         """Return the smallest distances of the motion at the union's breakpoints (U, k, d)."""
         k = motion.shape[1]
         planes = np.ascontiguousarray(np.moveaxis(motion, 2, 0))
         robots = _interval_minima(planes, knots) if k > 1 else None
-        pillars = (_interval_minima(planes, knots, bodies.obstacles, _pillar_offsets(bodies, k))
-                   if len(bodies.obstacles) else None)
+        pillars = (_interval_minima(planes, knots, constraints.obstacles,
+                                    _pillar_offsets(constraints, k))
+                   if len(constraints.obstacles) else None)
         return cls(planes, robots, pillars)
 
-    def gap(self, knots: _Knots, bodies: Bodies) -> float:
+    def gap(self, knots: _Knots, constraints: Constraints) -> float:
         """
         Return the motion's exact smallest gap, bit for bit certify's on the same breakpoints.
 
@@ -430,7 +431,8 @@ class _Nearest:
         monotone, so the smallest gap is the same number.
         """
         k = self.planes.shape[2]
-        radii = bodies.radii if np.any(bodies.radii > 0) else np.zeros_like(bodies.radii)
+        radii = constraints.radii
+        radii = radii if np.any(radii > 0) else np.zeros_like(radii)
         points, breakpoints = knots.points, self.planes.shape[1]
         legs = np.concatenate([np.arange(points[0]), np.arange(points[-1], breakpoints - 1)])
         gaps = [np.inf]
@@ -445,7 +447,7 @@ class _Nearest:
         if self.pillars is not None:
             offsets = radii[:k, None] + radii[None, k:]
             ends = self.planes[:, np.concatenate([legs, legs + 1]), :, None]
-            relative = ends - bodies.obstacles.T[:, None, None, :]
+            relative = ends - constraints.obstacles.T[:, None, None, :]
             squared, _ = segment_minimum(relative[:, :legs.size],
                                          relative[:, legs.size:] - relative[:, :legs.size])
             gaps.append(float((self.pillars - offsets).min()))
@@ -464,25 +466,25 @@ class _Caps:
     pillar); 0 at the configurations (design, 14).
     """
 
-    def __init__(self, nearest, knots, bodies, step):
+    def __init__(self, nearest, knots, constraints, step):
         """Compute the caps from the motion's smallest distances (_Nearest)."""
         intervals, k = knots.points.size - 1, nearest.planes.shape[2]
-        floor = bodies.margin + bodies.rounding
+        floor = constraints.margin + constraints.rounding
         pair = np.full((intervals, k), step)
         if nearest.robots is not None:
-            slack = nearest.robots - 2 * bodies.radii[0] - floor
+            slack = nearest.robots - 2 * constraints.radii[0] - floor
             pair = np.minimum(pair, PAIR_SHARE * np.maximum(slack, 0.0))
         pillar = np.full((intervals, k), 2 * step)
         if nearest.pillars is not None:
-            offsets = _pillar_offsets(bodies, k) + floor
+            offsets = _pillar_offsets(constraints, k) + floor
             slack = (nearest.pillars - offsets).min(axis=2)
             pillar = np.minimum(pillar, PILLAR_SHARE * np.maximum(slack, 0.0))
         self.pair, self.pillar = _knot_caps(pair), _knot_caps(pillar)
         self.lower = self.upper = self.inward = None
-        if bodies.bounds is not None:
-            self._walls(_interval_boxes(nearest.planes, knots.points), bodies, step)
+        if constraints.bounds is not None:
+            self._walls(_interval_boxes(nearest.planes, knots.points), constraints, step)
 
-    def _walls(self, boxes, bodies, step):
+    def _walls(self, boxes, constraints, step):
         """
         Add the walls: per axis, how far each knot may move down and up, and its pull inwards.
 
@@ -494,9 +496,9 @@ class _Caps:
         high one: 0 inside (design, 14).
         """
         low, high = boxes
-        keep = bodies.radii[0] + bodies.rounding
+        keep = constraints.radii[0] + constraints.rounding
         # (N - 1, k, d): the lowest corner's slack to each wall min, the highest's to each max.
-        slacks = [wall_slack(np.moveaxis(corner, 0, 2), bodies.bounds, keep)[..., side]
+        slacks = [wall_slack(np.moveaxis(corner, 0, 2), constraints.bounds, keep)[..., side]
                   for side, corner in enumerate((low, high))]
         self.lower, self.upper = (
             _knot_caps(np.minimum(2 * step, PILLAR_SHARE * np.maximum(slack, 0.0)))
@@ -634,11 +636,11 @@ def fleet_scale(configurations: np.ndarray, obstacles: np.ndarray) -> float:
 
 
 def refine(times: np.ndarray, positions: np.ndarray, waypoint_indices: np.ndarray,
-           bodies: Bodies) -> Refinement:
+           constraints: Constraints) -> Refinement:
     """
     Return the refined motion of the construction's motion (times (V,), positions (V, k, d)).
 
-    Every gap of the result stays >= bodies.margin, the configurations are its
+    Every gap of the result stays >= constraints.margin, the configurations are its
     breakpoints exactly, and it is a continuous function of the input (module
     docstring; doc/design.md section 14).
     """
@@ -649,18 +651,20 @@ def refine(times: np.ndarray, positions: np.ndarray, waypoint_indices: np.ndarra
     union = union_motion(times, positions, waypoint_indices, knot_grid)
     knots = _Knots.of(union, knot_grid)
     blocks = block_count(k)
-    nearest = _Nearest.of(union.positions, knots, bodies) if blocks else None
+    nearest = _Nearest.of(union.positions, knots, constraints) if blocks else None
     # The first block's distances give the union motion's exact gap where certify would
     # take every pair on every leg with the radii the caps take (one radius for every robot).
-    if (nearest is not None and evaluates_every_pair(union.positions, bodies.obstacles)
-            and np.all(bodies.radii >= 0) and np.all(bodies.radii[:k] == bodies.radii[0])):
-        gap = nearest.gap(knots, bodies)
+    if (nearest is not None and evaluates_every_pair(union.positions, constraints.obstacles)
+            and np.all(constraints.radii >= 0)
+            and np.all(constraints.radii[:k] == constraints.radii[0])):
+        gap = nearest.gap(knots, constraints)
     else:
-        gap = certify(union.times, union.positions, bodies.obstacles,
-                      bodies.radii if np.any(bodies.radii > 0) else None).distance
-    bodies = Bodies(bodies.obstacles, bodies.radii, min(bodies.margin, gap), bodies.rounding,
-                    bodies.bounds)
-    scale = fleet_scale(configurations, bodies.obstacles)
+        gap = certify(union.times, union.positions, constraints.obstacles,
+                      constraints.radii if np.any(constraints.radii > 0) else None).distance
+    constraints = Constraints(constraints.obstacles, constraints.radii,
+                              min(constraints.margin, gap), constraints.rounding,
+                              constraints.bounds)
+    scale = fleet_scale(configurations, constraints.obstacles)
     base_knots = _knots_last(union.positions[knots.points])
     # The field's values at the knots, in the sweeps' layout (d, k, N).
     values = np.zeros_like(base_knots)
@@ -668,8 +672,8 @@ def refine(times: np.ndarray, positions: np.ndarray, waypoint_indices: np.ndarra
     step = STEP * scale
     for block_index in range(blocks):
         if block_index:
-            nearest = _Nearest.of(motion, knots, bodies)
-        caps = _Caps(nearest, knots, bodies, step)
+            nearest = _Nearest.of(motion, knots, constraints)
+        caps = _Caps(nearest, knots, constraints, step)
         block = _Block(caps, step)
         common, own = ((np.zeros((d, 1, values.shape[2])), np.zeros_like(values))
                        if caps.inward is None else block.clip(_knots_last(caps.inward)))
@@ -681,4 +685,4 @@ def refine(times: np.ndarray, positions: np.ndarray, waypoint_indices: np.ndarra
         motion = union.positions + knots.field(np.transpose(values, (2, 1, 0)))
     motion[union.waypoint_indices] = configurations
     return Refinement(union.times, motion, union.waypoint_indices, union.base_legs,
-                      bodies.margin)
+                      constraints.margin)

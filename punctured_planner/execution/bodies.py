@@ -17,6 +17,8 @@ import numpy as np
 
 from ..core.certificate import segment_minimum
 from ..core.pairs import point_pairs
+from ..core.pairs import point_radii
+from ..core.pairs import PointPair
 
 
 @dataclass(frozen=True)
@@ -30,6 +32,19 @@ class Gap:
 
 
 @dataclass(frozen=True)
+class PairGaps:
+    """
+    Every pair's surface gap (pairs,) and its points a, b (core.pairs.point_pairs).
+
+    The pairs are the robot pairs, then every (robot, k + obstacle).
+    """
+
+    gaps: np.ndarray
+    a: np.ndarray
+    b: np.ndarray
+
+
+@dataclass(frozen=True)
 class Bodies:
     """The bodies' sizes: robot radius R, obstacle centres (r, 3) and radii (r,)."""
 
@@ -37,12 +52,11 @@ class Bodies:
     obstacles: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     obstacle_radii: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
-    def pair_gaps(self, start: np.ndarray, end: np.ndarray | None = None) -> tuple:
+    def pair_gaps(self, start: np.ndarray, end: np.ndarray | None = None) -> PairGaps:
         """
-        Return (gaps, a, b): every pair's smallest surface gap while moving start -> end.
+        Return every pair's smallest surface gap while moving start -> end.
 
-        start and end are (k, 3) centres (end None: the gaps at start). The pairs
-        are core.pairs.point_pairs(k, r): robot pairs, then (robot, k + obstacle).
+        start and end are (k, 3) centres (end None: the gaps at start).
         """
         k, r = len(start), len(self.obstacles)
         a, b = point_pairs(k, r)
@@ -56,17 +70,14 @@ class Bodies:
             squared, _ = segment_minimum(np.ascontiguousarray(relative.T),
                                          np.ascontiguousarray((moved[a] - moved[b]
                                                                - relative).T))
-        radii = np.concatenate([np.full(k, float(self.robot_radius)),
-                                np.asarray(self.obstacle_radii, dtype=float)])
-        return np.sqrt(squared) - radii[a] - radii[b], a, b
+        radii = point_radii(k, self.robot_radius, self.obstacle_radii)
+        return PairGaps(np.sqrt(squared) - radii[a] - radii[b], a, b)
 
     def smallest_gap(self, start: np.ndarray, end: np.ndarray | None = None) -> Gap:
         """Return the smallest surface Gap while moving start -> end (inf: nothing to meet)."""
-        gaps, a, b = self.pair_gaps(start, end)
-        if gaps.size == 0:
+        pairs = self.pair_gaps(start, end)
+        if pairs.gaps.size == 0:
             return Gap(np.inf)
-        i = int(np.argmin(gaps))
-        k = len(start)
-        if b[i] >= k:
-            return Gap(float(gaps[i]), 'obstacle', int(a[i]), int(b[i]) - k)
-        return Gap(float(gaps[i]), 'robots', int(a[i]), int(b[i]))
+        i = int(np.argmin(pairs.gaps))
+        pair = PointPair.from_points(pairs.a[i], pairs.b[i], len(start))
+        return Gap(float(pairs.gaps[i]), pair.kind, pair.first, pair.second)

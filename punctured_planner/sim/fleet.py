@@ -30,6 +30,7 @@ from dataclasses import field
 
 import numpy as np
 
+from ..core.pairs import PointPair
 from ..execution.bodies import Bodies
 from ..execution.execution import ExecutionSettings
 from ..execution.execution import saturate
@@ -102,7 +103,7 @@ class Fleet:
         """
         k = len(self.positions)
         self.settings = settings
-        gaps = settings.bodies.pair_gaps(self.positions)[0]
+        gaps = settings.bodies.pair_gaps(self.positions).gaps
         self._touching = gaps < 0
         self._start_gap = float(gaps.min(initial=np.inf))  # the gap where they stand now
         self.speed_factors = (np.ones(k) if settings.speed_factors is None
@@ -192,17 +193,18 @@ class Fleet:
             self.velocities = holonomic
         start = self.positions
         self.positions = start + self.velocities * dt
-        gaps, a, b = s.bodies.pair_gaps(start, self.positions)
+        pairs = s.bodies.pair_gaps(start, self.positions)
+        gaps = pairs.gaps
         if sagittas.any():
             # the arcs bow out of their chords by at most their sagittas: be conservative
             padded = np.concatenate([sagittas, np.zeros(len(s.bodies.obstacles))])
-            gaps = gaps - padded[a] - padded[b]
+            gaps = gaps - padded[pairs.a] - padded[pairs.b]
         if gaps.size:
             self.min_gap = min(self.min_gap, float(gaps.min()))
         touching = gaps < 0
-        k = self.robot_count
-        contacts = [Contact(now, 'robots' if b[i] < k else 'obstacle', int(a[i]),
-                            int(b[i]) if b[i] < k else int(b[i]) - k, float(gaps[i]))
-                    for i in np.flatnonzero(touching & ~self._touching)]
+        contacts = []
+        for i in np.flatnonzero(touching & ~self._touching):
+            pair = PointPair.from_points(pairs.a[i], pairs.b[i], self.robot_count)
+            contacts.append(Contact(now, pair.kind, pair.first, pair.second, float(gaps[i])))
         self._touching = touching
         return contacts
