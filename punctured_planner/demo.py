@@ -22,6 +22,7 @@ Ctrl-C stops everything cleanly. Exit 0 when the plan was executed, 1 otherwise.
 import argparse
 from collections.abc import Callable
 from collections.abc import Sequence
+from dataclasses import dataclass
 import os
 import signal
 import subprocess
@@ -45,6 +46,17 @@ if TYPE_CHECKING:  # ROS message types load with rclpy, in Recorder
 
 CONFIG = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), 'config')
 NODES = ('fleet_sim', 'planner_node', 'plan_executor')
+# The planner's latched plan topic, as the recorder hears it (namespace /demo).
+PLAN_TOPIC = '/demo/plan'
+
+
+@dataclass(frozen=True)
+class Heard:
+    """One recorded message: its topic, the message and its arrival (ns, the node's clock)."""
+
+    topic: str
+    message: Any
+    arrival_ns: int
 
 
 class Recorder:
@@ -66,15 +78,15 @@ class Recorder:
         self.executor = SingleThreadedExecutor()
         self.executor.add_node(self.node)
         self.names = names
-        self.messages: list[tuple[str, Any, int]] = []   # (topic, message, arrival ns)
+        self.messages: list[Heard] = []
         self.gap: list[float] = []
         self.odometry: dict[str, Odometry] = {}
 
         def keep(topic: str) -> Callable[[Any], None]:
             return lambda msg: self.messages.append(
-                (topic, msg, self.node.get_clock().now().nanoseconds))
+                Heard(topic, msg, self.node.get_clock().now().nanoseconds))
 
-        self.node.create_subscription(Plan, 'plan', keep('/demo/plan'), LATCHED)
+        self.node.create_subscription(Plan, 'plan', keep(PLAN_TOPIC), LATCHED)
         for name in names:
             self.node.create_subscription(PoseStamped, name + '/reference_pose',
                                           keep('/demo/%s/reference_pose' % name), 50)
@@ -173,11 +185,11 @@ def _print_arrival(recorder, response):
     from .execution.unicycle import yaws
     from .ros import conversions
     for i, name in enumerate(recorder.names):
-        position, orientation = conversions.odometry_pose(recorder.odometry[name])
-        goal, wanted = conversions.path_arrays(response.paths[i])[1:3]
-        heading = float(wrap(yaws(orientation[None]) - yaws(wanted[-1:]))[0])
+        pose = conversions.odometry_pose(recorder.odometry[name])
+        path = conversions.path_arrays(response.paths[i])
+        heading = float(wrap(yaws(pose.orientation[None]) - yaws(path.orientations[-1:]))[0])
         print('%s: %.4f m from its goal, heading %+.4f rad from the requested one'
-              % (name, np.linalg.norm(position - goal[-1]), heading))
+              % (name, np.linalg.norm(pose.position - path.positions[-1]), heading))
 
 
 def _print_ratios(recorder, executed, fleet):
@@ -191,8 +203,8 @@ def _print_ratios(recorder, executed, fleet):
     from .ros import conversions
     from .ros.settings import FleetSimSettings
     # the latched plan may reach this late-joined subscriber after the goal's result
-    recorder.spin(lambda: any(t == '/demo/plan' for t, _, _ in recorder.messages), 10)
-    plan = next(m for t, m, _ in recorder.messages if t == '/demo/plan')
+    recorder.spin(lambda: any(h.topic == PLAN_TOPIC for h in recorder.messages), 10)
+    plan = next(h.message for h in recorder.messages if h.topic == PLAN_TOPIC)
     reference = conversions.plan_reference(plan)
     factors = np.asarray(fleet.get('speed_factors') or [1.0] * reference.robot_count)
     slowest = int(np.argmin(factors))
@@ -228,23 +240,24 @@ def _write(recorder, response, mcap_path, gif_path):
     from .ros.recording import write_mcap
     from .viz.motion import render_motion
     messages = recorder.messages
-    write_mcap(mcap_path, [(t, m) for t, m, _ in messages], [ns for _, _, ns in messages],
-               {'plan_id': response.plan_id})
-    odometry = [(ns, m) for t, m, ns in messages if t.endswith('/odom')]
+    write_mcap(mcap_path, [(h.topic, h.message) for h in messages],
+               [h.arrival_ns for h in messages], {'plan_id': response.plan_id})
+    odometry = [h for h in messages if h.topic.endswith('/odom')]
     index = {name: i for i, name in enumerate(recorder.names)}
-    start = odometry[0][0]
+    start = odometry[0].arrival_ns
     frames, times, current = [], [], None
-    for ns, msg in odometry:
-        name = msg.child_frame_id.split('/')[0]
+    for heard in odometry:
+        name = heard.message.child_frame_id.split('/')[0]
         if current is None:
             current = np.full((len(index), 2), np.nan)
-        current[index[name]] = conversions.odometry_pose(msg)[0][:2]
+        current[index[name]] = conversions.odometry_pose(heard.message).position[:2]
         if not np.isnan(current).any():
             frames.append(current.copy())
-            times.append((ns - start) * 1e-9)
+            times.append((heard.arrival_ns - start) * 1e-9)
     positions = np.array(frames)
-    plan = next(m for t, m, _ in messages if t == '/demo/plan')
-    planned = np.stack([conversions.path_arrays(p)[1][:, :2] for p in plan.paths], axis=1)
+    plan = next(h.message for h in messages if h.topic == PLAN_TOPIC)
+    planned = np.stack([conversions.path_arrays(p).positions[:, :2] for p in plan.paths],
+                       axis=1)
     bodies = conversions.plan_bodies(plan)
     obstacles = bodies.obstacles[:, :2]
     gaps = np.minimum.accumulate([bodies.smallest_gap(np.c_[p, np.zeros(len(p))]).value

@@ -104,7 +104,7 @@ def test_one_pass_gives_both_certificates_of_bodies(robots):
     obstacles = rng.uniform(-5, 5, (4, 2))
     radii = np.concatenate([np.full(robots, 0.05), rng.uniform(0.0, 0.5, 4)])
     times = np.linspace(0.0, 1.0, 6)
-    clearance, gap = certificate.certify_bodies(times, positions, obstacles, radii)
-    assert clearance == certify(times, positions, obstacles)
-    assert gap == certify(times, positions, obstacles, radii)
-    assert gap.distance < clearance.distance
+    both = certificate.certify_bodies(times, positions, obstacles, radii)
+    assert both.clearance == certify(times, positions, obstacles)
+    assert both.gap == certify(times, positions, obstacles, radii)
+    assert both.gap.distance < both.clearance.distance

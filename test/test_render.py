@@ -178,7 +178,8 @@ def test_snapped_axis_contains_the_special_values_exactly():
 @pytest.mark.parametrize('robot_count', [1, 2])
 def test_start_goal_grid_shows_every_domain(robot_count):
     """The (start x, goal x) slice meets all n k + 1 domains, l = n r .. n (k + r)."""
-    workspace, _, request = teaching_scene(robot_count)
+    scene = teaching_scene(robot_count)
+    workspace, request = scene.workspace, scene.sliced
     starts, goals = (snapped_axis(-4.5, 4.5, 91, special)
                      for special in start_goal_specials(workspace, request))
     values = start_goal_grid(workspace, request, starts, goals)
@@ -189,7 +190,8 @@ def test_start_goal_grid_shows_every_domain(robot_count):
 
 def test_start_plane_grid_drops_on_the_obstacle_lines():
     """Robot 0's start in the plane: one less on x = obstacle x, NaN on the obstacles."""
-    workspace, request, _ = teaching_scene(1)
+    scene = teaching_scene(1)
+    workspace, request = scene.workspace, scene.plane
     xs = snapped_axis(-4.5, 4.5, 91, workspace.obstacles[:, 0])
     ys = snapped_axis(-4.5, 4.5, 91, [0.0])
     values = start_plane_grid(workspace, request, xs, ys)

@@ -464,10 +464,18 @@ def certify(times: np.ndarray, positions: np.ndarray, obstacles: np.ndarray,
     return _clearance(_closest(points, k, radii), times, k, exponent, resolution)
 
 
+@dataclass(frozen=True)
+class BodyCertificates:
+    """The two exact certificates of a motion of bodies: centre distance and surface gap."""
+
+    clearance: Clearance
+    gap: Clearance
+
+
 def certify_bodies(times: np.ndarray, positions: np.ndarray, obstacles: np.ndarray,
-                   radii: np.ndarray) -> tuple[Clearance, Clearance]:
+                   radii: np.ndarray) -> BodyCertificates:
     """
-    Return (centre-distance Clearance, surface-gap Clearance) of the motion, exactly.
+    Return the motion's centre-distance and surface-gap Clearances, exactly.
 
     certify twice, but where every pair is evaluated on every leg (up to
     _DIRECT_ROBOTS robots) both come from one pass: each pair's own minimum
@@ -477,16 +485,16 @@ def certify_bodies(times: np.ndarray, positions: np.ndarray, obstacles: np.ndarr
     points, radii, exponent, resolution = _scaled(positions, obstacles, radii)
     nothing = _nothing(positions, obstacles, resolution)
     if nothing is not None:
-        return nothing, nothing
+        return BodyCertificates(nothing, nothing)
     v, _, d = points.shape
     a, b = point_pairs(k, r)
     if k > _DIRECT_ROBOTS or a.size * v * d > _CHUNK_ELEMENTS:
-        return (_clearance(_closest(points, k), times, k, exponent, resolution),
-                _clearance(_closest(points, k, radii), times, k, exponent, resolution))
+        return BodyCertificates(
+            _clearance(_closest(points, k), times, k, exponent, resolution),
+            _clearance(_closest(points, k, radii), times, k, exponent, resolution))
     planes = _coordinate_first(points)
     both = [np.zeros(a.size), radii[a] + radii[b]]
     minima = _pruned_minima(planes, a, b, both)
     legs = np.arange(v - 1)
-    centres, surfaces = (_clearance(_smallest(minima, legs, offsets, a, b), times, k, exponent,
-                                    resolution) for offsets in both)
-    return centres, surfaces
+    return BodyCertificates(*(_clearance(_smallest(minima, legs, offsets, a, b), times, k,
+                                         exponent, resolution) for offsets in both))

@@ -21,7 +21,8 @@ import numpy.typing as npt
 from scipy.spatial import cKDTree
 
 from . import discs
-from .certificate import certify, certify_bodies, Clearance, RELATIVE_RESOLUTION
+from .certificate import (BodyCertificates, certify, certify_bodies, Clearance,
+                          RELATIVE_RESOLUTION)
 from .complexity import domain_range, sequential_complexity
 from .deformations import desingularize, desingularizing_shift, spread
 from .errors import ErrorCode, PlanningError
@@ -136,12 +137,12 @@ class Plan:
     def clearance(self) -> Clearance:
         """Return the exact Clearance certificate (computed once, on first use)."""
         if self.workspace.has_bodies:
-            return self._certificates[0]
+            return self._certificates.clearance
         return certify(self.times, self.positions, self.workspace.obstacles)
 
     @cached_property
-    def _certificates(self) -> tuple[Clearance, Clearance]:
-        """Return (clearance, gap) with bodies, both from one pass over pairs and legs."""
+    def _certificates(self) -> BodyCertificates:
+        """Return the clearance and gap with bodies, both from one pass over pairs and legs."""
         workspace = self.workspace
         k = self.positions.shape[1]
         radii = point_radii(k, workspace.robot_radius, workspace.obstacle_radii)
@@ -162,7 +163,7 @@ class Plan:
         """
         if not self.workspace.has_bodies:
             return self.clearance
-        return self._certificates[1]
+        return self._certificates.gap
 
     @property
     def min_gap(self) -> float:

@@ -35,6 +35,7 @@ Conventions:
 
 from collections.abc import Iterable
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 from builtin_interfaces.msg import Duration
 from builtin_interfaces.msg import Time
@@ -101,18 +102,27 @@ def pose_arrays_poses(messages: Iterable[PoseArray]) -> tuple[np.ndarray, np.nda
     return values[:, :3], values[:, 3:]
 
 
-def odometry_pose(msg: Odometry) -> tuple[np.ndarray, np.ndarray]:
-    """Return (position (3,), orientation (4,)) of a nav_msgs/Odometry message."""
+@dataclass(frozen=True)
+class PoseValues:
+    """A pose as arrays: position (3,) and orientation (4,) quaternion x, y, z, w."""
+
+    position: np.ndarray
+    orientation: np.ndarray
+
+
+def odometry_pose(msg: Odometry) -> PoseValues:
+    """Return the pose of a nav_msgs/Odometry message."""
     pose = msg.pose.pose
-    return (np.array([pose.position.x, pose.position.y, pose.position.z], dtype=float),
-            np.array([pose.orientation.x, pose.orientation.y, pose.orientation.z,
-                      pose.orientation.w], dtype=float))
+    return PoseValues(
+        np.array([pose.position.x, pose.position.y, pose.position.z], dtype=float),
+        np.array([pose.orientation.x, pose.orientation.y, pose.orientation.z,
+                  pose.orientation.w], dtype=float))
 
 
 def robot_odometry(msg: Odometry, received_ns: int) -> RobotOdometry:
     """Return the RobotOdometry of a nav_msgs/Odometry message that arrived at received_ns."""
-    position, orientation = odometry_pose(msg)
-    return RobotOdometry(position, orientation, msg.header.frame_id,
+    pose = odometry_pose(msg)
+    return RobotOdometry(pose.position, pose.orientation, msg.header.frame_id,
                          stamp_to_ns(msg.header.stamp), int(received_ns))
 
 
@@ -412,14 +422,23 @@ def plan_message(outcome: Outcome, settings: PlannerSettings) -> Plan:
                 tracking_tolerance=float(outcome.response.tracking_tolerance))
 
 
-def path_arrays(path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Return (stamps ns (M,), positions (M, 3), orientations (M, 4)) of a Path's poses."""
+@dataclass(frozen=True)
+class PathPoses:
+    """A Path's poses as arrays: stamps ns (M,), positions (M, 3), orientations (M, 4)."""
+
+    stamps: np.ndarray
+    positions: np.ndarray
+    orientations: np.ndarray
+
+
+def path_arrays(path: Path) -> PathPoses:
+    """Return the stamps, positions and orientations of a Path's poses."""
     rows = [(stamp_to_ns(p.header.stamp), p.pose.position.x, p.pose.position.y,
              p.pose.position.z, p.pose.orientation.x, p.pose.orientation.y,
              p.pose.orientation.z, p.pose.orientation.w) for p in path.poses]
     stamps = np.array([row[0] for row in rows], dtype=np.int64)
     values = np.array([row[1:] for row in rows], dtype=float).reshape(-1, 7)
-    return stamps, values[:, :3], values[:, 3:]
+    return PathPoses(stamps, values[:, :3], values[:, 3:])
 
 
 def plan_reference(msg: Plan) -> Reference:
@@ -438,16 +457,16 @@ def plan_reference(msg: Plan) -> Reference:
                          % (msg.plan_id, len(msg.robot_names), len(msg.paths)))
     ros_names('plan %d: robot_names' % msg.plan_id, tuple(msg.robot_names))
     arrays = [path_arrays(path) for path in msg.paths]
-    stamps = [a[0] for a in arrays]
+    stamps = [a.stamps for a in arrays]
     if not stamps or stamps[0].size < 2:
         count = stamps[0].size if stamps else 0
         raise ValueError('plan %d has %d pose%s per path, a motion at least 2'
                          % (msg.plan_id, count, '' if count == 1 else 's'))
-    for name, (robot_stamps, positions, orientations) in zip(msg.robot_names, arrays):
-        if not np.array_equal(robot_stamps, stamps[0]):
+    for name, path in zip(msg.robot_names, arrays):
+        if not np.array_equal(path.stamps, stamps[0]):
             raise ValueError('plan %d: the path of %s does not have the stamps of %s'
                              % (msg.plan_id, name, msg.robot_names[0]))
-        bad = first_non_finite(np.hstack([positions, orientations]))
+        bad = first_non_finite(np.hstack([path.positions, path.orientations]))
         if bad is not None:
             raise ValueError('plan %d: the path of %s has a non-finite pose (pose %d)'
                              % (msg.plan_id, name, bad[0]))
@@ -456,8 +475,8 @@ def plan_reference(msg: Plan) -> Reference:
         raise ValueError('plan %d: its stamps do not increase at pose %d of %d'
                          % (msg.plan_id, back[0] + 1, stamps[0].size))
     seconds = (stamps[0] - stamps[0][0]) * 1e-9
-    positions = np.stack([a[1] for a in arrays], axis=1)
-    orientations = normalized_quaternions(np.stack([a[2] for a in arrays], axis=1))
+    positions = np.stack([a.positions for a in arrays], axis=1)
+    orientations = normalized_quaternions(np.stack([a.orientations for a in arrays], axis=1))
     return Reference.timed(seconds, positions, orientations, float(msg.max_speed),
                            float(msg.max_acceleration), float(msg.min_gap))
 

@@ -9,6 +9,7 @@ obstacle gap), where all n k + 1 domains appear: open cells, lines, crossings.
 The lower strata are lines and points; they are drawn thickened to be seen.
 """
 
+from dataclasses import dataclass
 import os
 
 import matplotlib
@@ -30,14 +31,22 @@ PLANE_REQUEST = [[[-3.3, 1.0], [1.2, -1.4]], [[1.0, 2.0], [3.0, -2.0]]]
 SLICE_REQUEST = [[[0.0, 1.0], [2.0, -1.0]], [[0.0, 1.5], [2.0, -1.5]]]
 
 
-def teaching_scene(robot_count: int) -> tuple[Workspace, np.ndarray, np.ndarray]:
-    """Return (workspace, plane request, slice request) for 1 or 2 robots."""
+@dataclass(frozen=True)
+class TeachingScene:
+    """The picture's workspace and its two requests (n, k, 2): the left panel's, the right's."""
+
+    workspace: Workspace
+    plane: np.ndarray
+    sliced: np.ndarray
+
+
+def teaching_scene(robot_count: int) -> TeachingScene:
+    """Return the workspace and the two panels' requests for 1 or 2 robots."""
     if robot_count not in (1, 2):
         raise ValueError('the domain picture is drawn for 1 or 2 robots')
-    workspace = Workspace(TEACHING_OBSTACLES)
-    plane = np.array(PLANE_REQUEST)[:, :robot_count]
-    sliced = np.array(SLICE_REQUEST)[:, :robot_count]
-    return workspace, plane, sliced
+    return TeachingScene(Workspace(TEACHING_OBSTACLES),
+                         np.array(PLANE_REQUEST)[:, :robot_count],
+                         np.array(SLICE_REQUEST)[:, :robot_count])
 
 
 def thicken(values: np.ndarray, width: int = 2) -> np.ndarray:
@@ -106,14 +115,15 @@ def _slice_panel(ax, workspace, request, resolution, colours, norm):
 def domain_picture(path: str | os.PathLike[str], robot_count: int = 1, resolution: int = 361,
                    dpi: float = 100) -> str | os.PathLike[str]:
     """Draw the domain picture for robot_count (1 or 2) robots into a PNG at path; return path."""
-    workspace, plane, sliced = teaching_scene(robot_count)
+    scene = teaching_scene(robot_count)
+    workspace = scene.workspace
     r = workspace.obstacle_count
     low, high = domain_range(2, robot_count, r)
     colours, norm = domain_colours(low, high)
     figure = new_figure(11.5, 5.6, dpi)
     left, right = figure.subplots(1, 2)
-    _plane_panel(left, workspace, plane, resolution, colours, norm)
-    _slice_panel(right, workspace, sliced, resolution, colours, norm)
+    _plane_panel(left, workspace, scene.plane, resolution, colours, norm)
+    _slice_panel(right, workspace, scene.sliced, resolution, colours, norm)
     mappable = ScalarMappable(norm=norm, cmap=colours)
     bar = figure.colorbar(mappable, ax=[left, right], ticks=np.arange(low, high + 1),
                           shrink=0.85)
