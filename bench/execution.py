@@ -31,7 +31,7 @@ import tempfile
 import time
 
 import numpy as np
-from punctured_planner.cli import spin_until
+from punctured_planner.ros.client import spin_until
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 RESULTS_MD = os.path.join(HERE, 'execution.md')

@@ -36,7 +36,7 @@ import time
 
 from node_session import planner_session
 import numpy as np
-from punctured_planner.cli import call_service
+from punctured_planner.ros.client import call_service
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
                                 'test'))

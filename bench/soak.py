@@ -29,7 +29,7 @@ import time
 
 from node_session import planner_session
 import numpy as np
-from punctured_planner.cli import call_service
+from punctured_planner.ros.client import call_service
 
 OBSTACLES = ((-2.0, 0.5, 0.0), (0.0, -0.5, 0.0), (2.5, 0.0, 0.0))
 BAD_KINDS = ('nan', 'coincide', 'frame', 'over_limit', 'too_few')

@@ -14,9 +14,7 @@ would publish it.
 """
 
 import argparse
-from collections.abc import Callable
 from collections.abc import Sequence
-import contextlib
 import os
 import sys
 import time
@@ -26,8 +24,6 @@ from typing import TYPE_CHECKING
 import yaml
 
 if TYPE_CHECKING:  # rclpy and the ros modules load only where a command needs them
-    from rclpy.action.client import ClientGoalHandle
-    from rclpy.client import Client
     from rclpy.executors import Executor
     from rclpy.node import Node
     from rclpy.task import Future
@@ -35,6 +31,8 @@ if TYPE_CHECKING:  # rclpy and the ros modules load only where a command needs t
     from punctured_planner.ros.settings import PlannerSettings
     from punctured_planner.ros.snapshot import Outcome
 
+# The command's own node, in its private Context (ros/client.py).
+CLI_NODE = 'punctured_planner_cli'
 EXIT_OK = 0
 EXIT_PLANNER_ERROR = 1
 EXIT_USAGE = 2
@@ -76,94 +74,6 @@ def build_request(data: Any) -> Any:
     return fill_message(PlanSequence.Request(), data)
 
 
-def call_service(executor: 'Executor', client: 'Client', request: Any,
-                 timeout_sec: float) -> Any | None:
-    """
-    Call ``client`` once; return the response, or None on timeout.
-
-    Spins ``executor`` with spin_once until the future is done: in rclpy 7.1
-    repeated spin_until_future_complete leaves stale tasks behind.
-    """
-    future = client.call_async(request)
-    deadline = time.monotonic() + timeout_sec
-    while not future.done():
-        remaining = deadline - time.monotonic()
-        if remaining <= 0:
-            client.remove_pending_request(future)
-            return None
-        executor.spin_once(timeout_sec=min(remaining, 0.1))
-    return future.result()
-
-
-def spin_until(executor: 'Executor', predicate: Callable[[], bool], timeout_sec: float) -> bool:
-    """Spin ``executor`` (spin_once) until predicate() is true; return whether it became so."""
-    deadline = time.monotonic() + timeout_sec
-    while not predicate():
-        remaining = deadline - time.monotonic()
-        if remaining <= 0:
-            return False
-        executor.spin_once(timeout_sec=min(remaining, 0.05))
-    return True
-
-
-# Seconds without feedback after which a running goal's executor counts as gone:
-# plan_executor sends feedback every control step (20 Hz by default, msg_docs/ExecutePlan.md),
-# while DDS itself notices a killed process only when its lease ends (about 20 s).
-FEEDBACK_SILENCE_SEC = 5.0
-
-
-class GoalWatch:
-    """When an ExecutePlan goal's feedback last came: pass :meth:`heard` as its callback."""
-
-    def __init__(self) -> None:
-        """Start with no feedback heard."""
-        self.last_feedback: float | None = None  # time.monotonic()
-
-    def heard(self, feedback: Any) -> None:
-        """Feedback callback of send_goal_async: the executor is alive now."""
-        self.last_feedback = time.monotonic()
-
-    def silent_for(self) -> float:
-        """Return the seconds since the last feedback (0 before the first)."""
-        if self.last_feedback is None:
-            return 0.0
-        return time.monotonic() - self.last_feedback
-
-
-def wait_for_result(executor: 'Executor', handle: 'ClientGoalHandle', watch: GoalWatch,
-                    timeout_sec: float, silence_sec: float = FEEDBACK_SILENCE_SEC) -> Any | None:
-    """
-    Spin until the goal's result; return it, or None when the executor went away.
-
-    None once the goal's feedback, after it started, stopped for ``silence_sec``
-    (plan_executor died: no result will come) or ``timeout_sec`` passed.
-    """
-    future = handle.get_result_async()
-    gone = spin_until(executor, lambda: future.done() or watch.silent_for() > silence_sec,
-                      timeout_sec)
-    if gone and future.done():
-        return future.result().result
-    return None
-
-
-@contextlib.contextmanager
-def _ros_session():
-    """Yield (node, executor) in a private rclpy Context; shut everything down after."""
-    import rclpy
-    from rclpy.executors import SingleThreadedExecutor
-
-    context = rclpy.context.Context()
-    rclpy.init(context=context)
-    executor = SingleThreadedExecutor(context=context)
-    node = rclpy.create_node('punctured_planner_cli', context=context)
-    try:
-        yield node, executor
-    finally:
-        executor.shutdown()
-        node.destroy_node()
-        rclpy.try_shutdown(context=context)
-
-
 def _request(args):
     """Return the request of args.request, or None after saying why it is bad."""
     try:
@@ -174,13 +84,15 @@ def _request(args):
 
 
 def _call(args):
+    from punctured_planner.ros.client import call_service
+    from punctured_planner.ros.client import session
     from punctured_planner.ros.qos import CLIENT_QOS
     from punctured_planner_interfaces.srv import PlanSequence
 
     request = _request(args)
     if request is None:
         return EXIT_USAGE
-    with _ros_session() as (node, executor):
+    with session(CLI_NODE) as (node, executor):
         client = node.create_client(PlanSequence, args.service, qos_profile=CLIENT_QOS)
         if not client.wait_for_service(timeout_sec=args.wait):
             print('punctured-planner: service %s not available after %.1f s'
@@ -208,15 +120,14 @@ def reset_obstacles(node: 'Node', executor: 'Executor', planner_node: str,
     from rclpy.parameter import parameter_value_to_python
     from rclpy.parameter_client import AsyncParameterClient
 
+    from punctured_planner.ros.client import spin_until
+
     remote = AsyncParameterClient(node, planner_node)
     if not remote.wait_for_services(timeout_sec=timeout_sec):
         return 'parameter services of %s not available' % planner_node
 
     def wait(future: 'Future') -> Any | None:
-        deadline = time.monotonic() + timeout_sec
-        while not future.done() and time.monotonic() < deadline:
-            executor.spin_once(timeout_sec=0.1)
-        return future.result() if future.done() else None
+        return future.result() if spin_until(executor, future.done, timeout_sec) else None
 
     got = wait(remote.get_parameters(['obstacles']))
     if got is None or not got.values:
@@ -237,7 +148,8 @@ def reset_obstacles(node: 'Node', executor: 'Executor', planner_node: str,
 
 
 def _reset(args):
-    with _ros_session() as (node, executor):
+    from punctured_planner.ros.client import session
+    with session(CLI_NODE) as (node, executor):
         executor.add_node(node)
         problem = reset_obstacles(node, executor, args.node, args.wait)
     if problem:

@@ -36,13 +36,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 import yaml
 
-from .cli import FEEDBACK_SILENCE_SEC
-from .cli import GoalWatch
-from .cli import spin_until
-from .cli import wait_for_result
-
-if TYPE_CHECKING:  # ROS message types load with rclpy, in Recorder
+if TYPE_CHECKING:  # rclpy and ROS message types load where the demo runs them
     from nav_msgs.msg import Odometry
+    from rclpy.executors import Executor
+    from rclpy.node import Node
 
 CONFIG = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), 'config')
 NODES = ('fleet_sim', 'planner_node', 'plan_executor')
@@ -62,20 +59,17 @@ class Heard:
 class Recorder:
     """A client node that records what the demo needs, with arrival times."""
 
-    def __init__(self, names: list[str]) -> None:
-        """Create the node, its executor and subscriptions (in /demo)."""
-        import rclpy
+    def __init__(self, node: 'Node', executor: 'Executor', names: list[str]) -> None:
+        """Subscribe node (in /demo, a client session's) and spin it with executor."""
         from geometry_msgs.msg import PoseStamped
         from geometry_msgs.msg import Twist
         from nav_msgs.msg import Odometry
         from punctured_planner_interfaces.msg import Plan
-        from rclpy.executors import SingleThreadedExecutor
         from std_msgs.msg import Float64
 
         from .ros.qos import LATCHED
-        rclpy.init(args=[])
-        self.node = rclpy.create_node('demo', namespace='/demo')
-        self.executor = SingleThreadedExecutor()
+        self.node = node
+        self.executor = executor
         self.executor.add_node(self.node)
         self.names = names
         self.messages: list[Heard] = []
@@ -107,14 +101,8 @@ class Recorder:
 
     def spin(self, predicate: Callable[[], bool], timeout_sec: float) -> bool:
         """Spin until predicate() or the timeout; return whether it became true."""
+        from .ros.client import spin_until
         return spin_until(self.executor, predicate, timeout_sec)
-
-    def close(self) -> None:
-        """Destroy the node and shut rclpy down."""
-        import rclpy
-        self.executor.shutdown()
-        self.node.destroy_node()
-        rclpy.try_shutdown()
 
 
 def _run(recorder, request_path, mcap_path, gif_path, fleet):
@@ -127,7 +115,10 @@ def _run(recorder, request_path, mcap_path, gif_path, fleet):
     from punctured_planner_interfaces.srv import PlanSequence
     from rclpy.action import ActionClient
 
-    from .cli import call_service
+    from .ros.client import call_service
+    from .ros.client import FEEDBACK_SILENCE_SEC
+    from .ros.client import GoalWatch
+    from .ros.client import wait_for_result
     from .ros.msg_dict import fill_message
     from .ros.qos import CLIENT_QOS
     node = recorder.node
@@ -310,16 +301,15 @@ def main(argv: Sequence[str] | None = None) -> int:
          params], stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
         for name, log in zip(NODES, log_files)]
     print('started %s (logs in %s)' % (', '.join(NODES), logs))
-    recorder = None
+    from .ros.client import session
     code = 1
     try:
-        recorder = Recorder(names)
-        code = _run(recorder, args.request, args.mcap, args.gif, fleet)
+        with session('demo', namespace='/demo') as (node, executor):
+            code = _run(Recorder(node, executor, names), args.request, args.mcap, args.gif,
+                        fleet)
     except KeyboardInterrupt:
         print('demo: interrupted')
     finally:
-        if recorder is not None:
-            recorder.close()
         for process in processes:
             process.send_signal(signal.SIGINT)
         for process in processes:

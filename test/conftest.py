@@ -114,7 +114,7 @@ class RosClient:
 
     def call(self, client, request, timeout_sec=20.0):
         """Send ``request`` and return the response; fail the test on timeout."""
-        from punctured_planner.cli import call_service
+        from punctured_planner.ros.client import call_service
         response = call_service(self.executor, client, request, timeout_sec)
         if response is None:
             pytest.fail('no response from %s within %.1f s' % (client.srv_name, timeout_sec))

@@ -71,7 +71,7 @@ def graph(ros_client, ros_env, tmp_path):
 
 def moving_goal(graph):
     """Plan START -> GOAL, send its goal with a GoalWatch; return (handle, feedback, watch)."""
-    from punctured_planner.cli import GoalWatch
+    from punctured_planner.ros.client import GoalWatch
     from punctured_planner_interfaces.action import ExecutePlan
     response = graph.plan([GOAL])
     watch = GoalWatch()
@@ -145,7 +145,7 @@ def test_fleet_sim_killed(graph):
 
 
 def test_planner_node_killed(graph):
-    from punctured_planner.cli import wait_for_result
+    from punctured_planner.ros.client import wait_for_result
     from punctured_planner_interfaces.action import ExecutePlan
     handle, _, watch = moving_goal(graph)
     kill(graph.processes['planner_node'])
@@ -163,8 +163,8 @@ def test_planner_node_killed(graph):
 
 def test_plan_executor_killed(graph):
     from nav_msgs.msg import Odometry
-    from punctured_planner.cli import FEEDBACK_SILENCE_SEC
-    from punctured_planner.cli import wait_for_result
+    from punctured_planner.ros.client import FEEDBACK_SILENCE_SEC
+    from punctured_planner.ros.client import wait_for_result
     heard = []  # (arrival, stamp, robot, speed): fleet_sim's clock is the stamp
     for i, name in enumerate(NAMES):
         graph.client.node.create_subscription(

@@ -126,8 +126,8 @@ def test_corners_slow_the_clock_before_a_turn_and_not_elsewhere():
     assert caps[0] == 1.0 and caps[-1] == 1.0, 'no corner within the lookahead'
     assert caps[1] > caps[2] > caps[3] >= unicycle.CORNER_RATE
     assert caps[3] <= unicycle.CORNER_RATE + 0.01
-    directions, starts = corners.upcoming(0.5)
-    assert np.allclose(directions, [[0.5, 0, 0]]) and starts[0] == 0.5
+    upcoming = corners.upcoming(0.5)
+    assert np.allclose(upcoming.directions, [[0.5, 0, 0]]) and upcoming.still_until[0] == 0.5
 
 
 def test_a_robot_standing_still_turns_to_its_next_move_without_holding_the_clock():

@@ -36,6 +36,10 @@ from .timing import (corner_jump, leg_at, length_times, resample, speed_profile,
 from .validation import validate_configurations
 from .walls import smallest_leg_slack, WallSlack
 
+# How far a picture's axis (Plan.axis_segment) reaches beyond the projections: this share of
+# their spread.
+AXIS_MARGIN = 0.08
+
 
 @dataclass(frozen=True, eq=False)
 class Samples:
@@ -225,26 +229,26 @@ class Plan:
             separation /= k + self.workspace.obstacle_count
         return float(min(separation, self._spacing.min(), self.workspace.lane_spacing))
 
-    def axis_segment(self, margin: float = 0.08) -> np.ndarray:
+    def axis_segment(self) -> np.ndarray:
         """
         Return the (2, d) end points of the part of the axis o + s e1 a picture shows.
 
-        It covers every robot's and every obstacle's projection, with margin
+        It covers every robot's and every obstacle's projection, with AXIS_MARGIN
         times their spread (at least 1) beyond each end.
         """
         values = np.concatenate([self.frame.project(self.positions).ravel(),
                                  self.workspace.obstacle_projections])
         low, high = float(values.min()), float(values.max())
-        pad = margin * max(high - low, 1.0)
+        pad = AXIS_MARGIN * max(high - low, 1.0)
         return self.frame.axis_points(np.array([low - pad, high + pad]))
 
-    def lane_segments(self, margin: float = 0.08) -> np.ndarray:
+    def lane_segments(self) -> np.ndarray:
         """
         Return the (L, 2, d) end points of the lanes: the axis segment lifted by each lane.
 
         One lane per robot (L = k), except for 'discs', whose robots share lanes.
         """
-        return self.axis_segment(margin)[None] + self.lanes[:, None, None] * self.frame.e2
+        return self.axis_segment()[None] + self.lanes[:, None, None] * self.frame.e2
 
     def position(self, tau: npt.ArrayLike) -> np.ndarray:
         """Return the robot positions at parameter(s) tau in [0, 1]: (k, d) or (..., k, d)."""

@@ -409,8 +409,9 @@ class Execution:
         that costs the clock nothing.
         """
         s = self.settings
-        directions, still_until = self.corners.upcoming(self.plan_time)
-        alpha = unicycle.misalignment(self._driving(angles), directions)
+        upcoming = self.corners.upcoming(self.plan_time)
+        still_until = upcoming.still_until
+        alpha = unicycle.misalignment(self._driving(angles), upcoming.directions)
         may_turn = watched <= s.hold_fraction * self.tolerance - 2.0 * self.lead
         flip = self.differential & may_turn & (np.abs(alpha) > unicycle.REVERSE_ANGLE)
         self.reverse ^= flip

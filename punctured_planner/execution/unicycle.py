@@ -182,6 +182,14 @@ def creep_rate(angles: np.ndarray, speeds: np.ndarray, steering_length: float,
     return np.where(np.abs(angles) > REVERSE_ANGLE, 0.0, rates)
 
 
+@dataclass(frozen=True)
+class Upcoming:
+    """Where each reference moves next: directions (k, 3), and when, still_until (k,)."""
+
+    directions: np.ndarray
+    still_until: np.ndarray
+
+
 class Corners:
     """A reference's moving intervals per robot, for the turns ahead of the clock."""
 
@@ -225,9 +233,9 @@ class Corners:
             result[moves[1:][np.abs(beta) > REVERSE_ANGLE]] = True
         return result
 
-    def upcoming(self, s: float) -> tuple:
+    def upcoming(self, s: float) -> Upcoming:
         """
-        Return (directions (k, 3), still_until (k,)): where each reference moves next, and when.
+        Return where each reference moves next, and when.
 
         Where robot i's reference moves at s, still_until is s and the direction
         its current one; where it stands still, the direction of its next move
@@ -235,7 +243,7 @@ class Corners:
         """
         k = self.speeds.shape[1] if self.speeds.size else 0
         if self.speeds.size == 0 or s >= self.seconds[-1]:
-            return np.zeros((k, 3)), np.full(k, np.inf)
+            return Upcoming(np.zeros((k, 3)), np.full(k, np.inf))
         j = int(leg_at(self.seconds, s))
         nxt = self.next_moving[j]
         has = nxt < len(self.speeds)
@@ -243,7 +251,7 @@ class Corners:
         directions = self.velocities[rows, np.arange(k)]
         directions = np.where(has[:, None], directions, 0.0)
         starts = np.where(has, np.maximum(self.seconds[rows], s), np.inf)
-        return directions, starts
+        return Upcoming(directions, starts)
 
     def corner_caps(self, s: float, steering_length: float,
                     yaw_rate_limit: float) -> np.ndarray:

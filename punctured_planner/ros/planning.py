@@ -33,14 +33,16 @@ from ..core import ErrorCode
 from ..core import PlanningError
 from ..core import Workspace
 
+# Workspaces kept (one per obstacle set and options): a few, for topics that alternate.
+WORKSPACE_CACHE_SIZE = 4
+
 
 class PlanSequenceHandler:
     """Answers PlanSequence requests; keeps the last few Workspaces (one per obstacle set)."""
 
-    def __init__(self, cache_size: int = 4) -> None:
+    def __init__(self) -> None:
         """Create an empty workspace cache."""
         self._cache: OrderedDict = OrderedDict()
-        self._cache_size = cache_size
         self._lock = threading.Lock()
 
     def workspace(self, settings: PlannerSettings, obstacles: np.ndarray) -> Workspace:
@@ -68,7 +70,7 @@ class PlanSequenceHandler:
                               bounds=settings.core_bounds)
         with self._lock:
             self._cache[key] = workspace
-            while len(self._cache) > self._cache_size:
+            while len(self._cache) > WORKSPACE_CACHE_SIZE:
                 self._cache.popitem(last=False)
         return workspace
 

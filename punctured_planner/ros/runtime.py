@@ -150,9 +150,8 @@ class StopSignals:
     Enter it from the main thread (Python sets signal handlers only there).
     """
 
-    def __init__(self, signals: Sequence[int] = STOP_SIGNALS):
-        """Remember which signals to take over; nothing changes before ``__enter__``."""
-        self._signals = tuple(signals)
+    def __init__(self) -> None:
+        """Take over nothing before ``__enter__``."""
         self._previous: dict = {}
         self._previous_fd = -1
         self._read_fd = self._write_fd = -1
@@ -162,7 +161,7 @@ class StopSignals:
         self._read_fd, self._write_fd = os.pipe()
         os.set_blocking(self._write_fd, False)
         self._previous_fd = signal.set_wakeup_fd(self._write_fd, warn_on_full_buffer=False)
-        for number in self._signals:
+        for number in STOP_SIGNALS:
             self._previous[number] = signal.signal(number, _ignore)
         return self
 
@@ -178,7 +177,7 @@ class StopSignals:
         """Block until a stop signal or :meth:`wake`; return the signal number, or 0 if woken."""
         while True:
             for number in os.read(self._read_fd, 64):
-                if number in self._signals or number == _WOKEN:
+                if number in STOP_SIGNALS or number == _WOKEN:
                     return number
 
     def wake(self) -> None:
@@ -381,9 +380,9 @@ class ExecutorThreads:
         return [node.get_fully_qualified_name()
                 for node, thread in zip(self.nodes, self._threads) if thread.is_alive()]
 
-    def linger(self, grace_sec: float = REPLY_GRACE_SEC) -> float:
+    def linger(self) -> float:
         """
-        Wait until ``grace_sec`` after the last reply written, if any; return the wait.
+        Wait until REPLY_GRACE_SEC after the last reply written, if any; return the wait.
 
         The wait ends sooner once no client of the services that replied is left
         (a one-shot caller such as ``ros2 service call`` has its reply and is gone),
@@ -392,7 +391,7 @@ class ExecutorThreads:
         if self._last_reply is None:
             return 0.0
         started = time.monotonic()
-        end = self._last_reply + grace_sec
+        end = self._last_reply + REPLY_GRACE_SEC
         while (remaining := end - time.monotonic()) > 0.0 and self._awaited():
             time.sleep(min(remaining, LINGER_POLL_SEC))
         return time.monotonic() - started
@@ -403,10 +402,9 @@ class ExecutorThreads:
             node.count_clients(name) > 0 for name, node in self._replied.items())
 
     def close(self, timeout_sec: float = STOP_TIMEOUT_SEC,
-              before_teardown: Optional[Callable[[], None]] = None,
-              grace_sec: float = REPLY_GRACE_SEC) -> bool:
+              before_teardown: Optional[Callable[[], None]] = None) -> bool:
         """
-        stop(), before_teardown, linger(grace_sec), destroy the nodes in reverse order.
+        stop(), before_teardown, linger(), destroy the nodes in reverse order.
 
         The whole stop (module docstring). Return False (and leave everything
         as it is) if stop() failed.
@@ -415,7 +413,7 @@ class ExecutorThreads:
             return False
         if before_teardown is not None:
             before_teardown()
-        lingered = self.linger(grace_sec)
+        lingered = self.linger()
         if lingered > 0.0:
             self.nodes[0].get_logger().debug(
                 'stopping: kept the participant %.3f s for the last reply' % lingered)
