@@ -378,6 +378,27 @@ def test_the_walls_choose_the_frame_with_the_most_room_beyond_the_obstacles():
     assert refused.value.wall == Wall(1, True), str(refused.value)
 
 
+def test_the_room_counts_the_bodies_balls_among_pillars_in_a_low_hall_stage_beside_them():
+    """
+    Balls among ball pillars in a hall 2 m high stage beside the pillars, not above them.
+
+    The room is the robots' centres' (R inside the walls) beyond each pillar's
+    clearance (doc/design.md section 4): counting the pillars' centres alone chose e2 =
+    +z, where the bodies fill the hall's height, and the plan left by the ceiling.
+    """
+    hall = np.array([[-5.0, 5.0], [-5.0, 5.0], [-1.0, 1.0]])
+    pillars = np.array([[0.0, 0.0, 0.0], [2.0, 1.0, 0.0], [-2.0, -1.0, 0.0]])
+    row = np.array([[-3.0, -3.0, 0.0], [-1.0, -3.0, 0.0], [1.0, -3.0, 0.0], [3.0, -3.0, 0.0]])
+    configurations = np.stack([row, -row])
+    workspace = Workspace(pillars, bounds=hall, variant='discs', robot_radius=0.2,
+                          obstacle_radius=0.3)
+    assert workspace.frame.e2[2] == 0.0, workspace.frame.e2
+    result = plan(workspace, configurations)
+    assert (result.positions - 0.2 >= hall[:, 0]).all()
+    assert (result.positions + 0.2 <= hall[:, 1]).all()
+    assert result.min_gap >= 0.0
+
+
 def test_equal_rooms_go_to_the_first_frame_and_rounding_separates_no_pillars():
     """
     Ties of rooms go to the axis frames; rounding alone separates no pillars.

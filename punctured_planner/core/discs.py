@@ -231,6 +231,38 @@ class WallRoom:
 
 
 @dataclass(frozen=True, eq=False)
+class PillarClearance:
+    """
+    What the bodies' sizes fix before any frame: each pillar's reach and clearance, the pitch.
+
+    reach w_j = R + rho_j + mu_j; pitch g the slots' and lanes'; clear_j how far
+    beyond pillar j's centre along e2 the fleet stages (top, DiscLayout): above its
+    zone, and as far above the pillar as the slots keep robots apart.
+    """
+
+    reach: np.ndarray
+    apart: float
+    pitch: float
+    clear: np.ndarray
+
+    @classmethod
+    def from_radii(cls, robot_radius: float, obstacle_radius: np.ndarray,
+                   min_spacing: float) -> 'PillarClearance':
+        """Return the clearance of pillars of radii (r,) for robots of radius R."""
+        # A passing margin for every pillar size: mu_j = 0 (rho_j >= R, before) let bodies
+        # graze. S stays 4R while w_j <= 1.9R (rho_j <= 0.8R); wider margins make
+        # neighbouring pillars' zones overlap more often (measured in bench/).
+        margin = MARGIN * np.maximum(robot_radius, obstacle_radius)
+        reach = robot_radius + obstacle_radius + margin
+        reach = np.where(reach > 0, reach, 0.5 * min_spacing)
+        apart = (2.0 + MARGIN) * robot_radius
+        pitch = max(min_spacing, apart)
+        # A robot staged clear of pillar j passes it with at least the slots' gap g - 2R.
+        clear = np.maximum(ZONE * reach, obstacle_radius + pitch - robot_radius)
+        return cls(reach, apart, pitch, clear)
+
+
+@dataclass(frozen=True, eq=False)
 class DiscLayout:
     """
     What the construction fixes per workspace: the pillars and pitches.
@@ -266,19 +298,11 @@ class DiscLayout:
 
         bounds (d, 2), or None for no walls, give the room the walls leave (WallRoom).
         """
-        # A passing margin for every pillar size: mu_j = 0 (rho_j >= R, before) let bodies
-        # graze. S stays 4R while w_j <= 1.9R (rho_j <= 0.8R); wider margins make
-        # neighbouring pillars' zones overlap more often (measured in bench/).
-        margin = MARGIN * np.maximum(robot_radius, obstacle_radius)
-        reach = robot_radius + obstacle_radius + margin
-        reach = np.where(reach > 0, reach, 0.5 * min_spacing)
+        sizes = PillarClearance.from_radii(robot_radius, obstacle_radius, min_spacing)
+        reach, apart, pitch = sizes.reach, sizes.apart, sizes.pitch
         offsets = frame.offset(obstacles)
-        apart = (2.0 + MARGIN) * robot_radius
-        pitch = max(min_spacing, apart)
-        # Above every zone, and as far above every pillar as the slots keep robots apart:
-        # a robot staged there passes each pillar with at least the slots' gap g - 2R.
-        clear = np.maximum(ZONE * reach, obstacle_radius + pitch - robot_radius)
-        top = float((offsets + clear).max()) if len(obstacles) else 0.0
+        # Above every pillar's clearance (PillarClearance).
+        top = float((offsets + sizes.clear).max()) if len(obstacles) else 0.0
         separation = max(4.0 * robot_radius, apart + float(reach.max(initial=0.0)))
         # The stack keeps the slots' pitch where it can; the fade is what condition (a)
         # allows for the least it must keep, sqrt 2 (2R + nu) (module docstring).

@@ -109,17 +109,23 @@ def _frame_directions(d, oblique):
             yield e1 * np.sign(e1[int(np.argmax(np.abs(e1)))]), e2
 
 
-def _room(obstacles, bounds, e2):
+def _room(obstacles, bounds, e2, clearance, robot_radius):
     """
-    Return the measure (area, volume) of the walls' box beyond every obstacle along e2.
+    Return the measure (area, volume) of the robots' room beyond every obstacle along e2.
 
-    The box cut by the plane through the farthest obstacle along e2 is convex: its
-    vertices are the corners beyond the plane and the points where the box's edges
-    cross it, and their convex hull (qhull) is where every construction stages and
-    runs its lanes.
+    The robots' centres keep robot_radius from the walls, and every construction
+    stages beyond each obstacle's clearance (r,) along e2 (its centre's offset plus
+    that much). The centres' box cut by the plane through the farthest of those is
+    convex: its vertices are the corners beyond the plane and the points where the
+    box's edges cross it, and their convex hull (qhull) is where every construction
+    stages and runs its lanes. Counting the centres' offsets alone chose, for balls
+    among pillars in a low hall, the room above them: the height the bodies fill.
     """
-    corners = box_corners(bounds)
-    height = corners @ e2 - float((obstacles @ e2).max())
+    inside = bounds + np.array([robot_radius, -robot_radius])
+    if np.any(inside[:, 0] > inside[:, 1]):
+        return 0.0
+    corners = box_corners(inside)
+    height = corners @ e2 - float((obstacles @ e2 + clearance).max())
     if height.max() <= 0.0:
         return 0.0
     # The box's edges: corners whose indices differ in one bit (box_corners).
@@ -137,13 +143,14 @@ def _room(obstacles, bounds, e2):
         return 0.0
 
 
-def _most_room(obstacles, bounds, directions):
+def _most_room(obstacles, bounds, directions, clearance, robot_radius):
     """
     Return the index of the direction e2 with the most room (_room) among directions.
 
     Rooms within _ROOM_TIE of the most are a tie, which the first of them wins.
     """
-    rooms = np.array([_room(obstacles, bounds, e2) for e2 in directions])
+    rooms = np.array([_room(obstacles, bounds, e2, clearance, robot_radius)
+                      for e2 in directions])
     return int(np.argmax(rooms >= rooms.max() * (1.0 - _ROOM_TIE)))
 
 
@@ -185,7 +192,8 @@ def _is_axis(frame):
 
 
 def choose_frame(obstacles: np.ndarray, bounds: np.ndarray | None = None,
-                 oblique: bool = False, robot_radius: float = 0.0) -> Frame:
+                 oblique: bool = False, robot_radius: float = 0.0,
+                 clearance: np.ndarray | float = 0.0) -> Frame:
     """
     Return the default frame for obstacles (r, d): deterministic, fixed per workspace.
 
@@ -194,9 +202,10 @@ def choose_frame(obstacles: np.ndarray, bounds: np.ndarray | None = None,
     frames, and with oblique (bodies, whose margins are far above the rounding an
     oblique frame brings into every projection; not point robots) in the plane e2 at
     _OBLIQUE_DIRECTIONS angles. Every construction stages and runs its lanes beyond the
-    farthest obstacle along e2, so with walls (bounds (d, 2)) the frame is the one with
-    the most room there (_room: the area, or volume, of the walls' box beyond that
-    obstacle); without walls, for bodies, the one whose farthest obstacle is nearest the
+    farthest obstacle along e2 (beyond its clearance, (r,) or one for all: the discs'
+    PillarClearance), so with walls (bounds (d, 2)) the frame is the one with the most
+    room there (_room: the area, or volume, of the robots' centres' box, robot_radius
+    inside the walls, beyond that); without walls, for bodies, the one whose farthest obstacle is nearest the
     middle of the obstacles (_reach), an oblique frame only where it saves more than
     robot_radius of that climb over every axis frame; otherwise the first, the coordinate
     axes when they separate the obstacles (e1 = x, e2 = y). Ties go to the first, the
@@ -215,7 +224,8 @@ def choose_frame(obstacles: np.ndarray, bounds: np.ndarray | None = None,
               if r < 2 or np.all(np.diff(np.sort(frame.project(obstacles)))
                                  > (0.0 if _is_axis(frame) else resolution))]
     if frames and r > 0 and bounds is not None:
-        return frames[_most_room(obstacles, bounds, [frame.e2 for frame in frames])]
+        return frames[_most_room(obstacles, bounds, [frame.e2 for frame in frames],
+                                 clearance, robot_radius)]
     if frames and r > 0 and oblique:
         # The axis frames keep the request's own coordinates (lanes along the building's
         # walls, exact projections): an oblique one must pay for itself (design section 4).
@@ -230,7 +240,7 @@ def choose_frame(obstacles: np.ndarray, bounds: np.ndarray | None = None,
     e1 = directions[int(np.argmax(gaps))]
     e2 = _complement_direction(e1)
     if bounds is not None:  # towards the more room, as every other frame with walls
-        e2 = (e2, -e2)[_most_room(obstacles, bounds, (e2, -e2))]
+        e2 = (e2, -e2)[_most_room(obstacles, bounds, (e2, -e2), clearance, robot_radius)]
     return Frame(_origin(obstacles, bounds, e1), e1, e2)
 
 

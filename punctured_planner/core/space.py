@@ -10,7 +10,7 @@ import numbers
 import numpy as np
 import numpy.typing as npt
 
-from .discs import DiscLayout
+from .discs import DiscLayout, PillarClearance
 from .errors import ErrorCode, literal, PlanningError
 from .frame import checked_frame, choose_frame, Frame
 from .limits import checked_length, first_out_of_range, length_range, lengths_in_range
@@ -102,11 +102,8 @@ class Workspace:
         self.robot_radius, self.obstacle_radii = _checked_radii(robot_radius, obstacle_radius,
                                                                 len(obstacles))
         self._reject_coincident_obstacles()
-        # Oblique frames round every projection: only the discs' margins are far above that.
-        self.frame = (choose_frame(obstacles, self.bounds, oblique=variant == 'discs',
-                                   robot_radius=self.robot_radius)
-                      if frame is None
-                      else checked_frame(frame, self.dimension))
+        self.frame = self._default_frame() if frame is None else checked_frame(frame,
+                                                                               self.dimension)
         self.obstacle_projections = self.frame.project(obstacles)
         same = _coincident_pair(self.obstacle_projections)
         if same is not None:
@@ -172,11 +169,29 @@ class Workspace:
         With bodies, a required gap c is planned for by inflating every body by
         c / 2: a gap >= 0 between the inflated bodies is a gap >= c between the real ones.
         """
+        robot_radius, obstacle_radii = self._planned_radii()
+        return DiscLayout.from_radii(self.frame, self.obstacles, robot_radius, obstacle_radii,
+                                     self.min_spacing, self.bounds)
+
+    def _planned_radii(self):
+        """Return (R, rho (r,)) as planned for: inflated by half the required gap c."""
         inflation = 0.5 * self.required_clearance if self.has_bodies else 0.0
-        return DiscLayout.from_radii(self.frame, self.obstacles,
-                                     self.robot_radius + inflation,
-                                     self.obstacle_radii + inflation, self.min_spacing,
-                                     self.bounds)
+        return self.robot_radius + inflation, self.obstacle_radii + inflation
+
+    def _default_frame(self):
+        """
+        Return choose_frame's frame for the obstacles and walls.
+
+        Oblique frames round every projection: only the discs' margins are far above
+        that. The discs stage beyond each pillar's clearance (PillarClearance), their
+        centres R inside the walls, which is the room the frame is chosen by.
+        """
+        if self.variant != 'discs':
+            return choose_frame(self.obstacles, self.bounds)
+        robot_radius, obstacle_radii = self._planned_radii()
+        clearance = PillarClearance.from_radii(robot_radius, obstacle_radii, self.min_spacing)
+        return choose_frame(self.obstacles, self.bounds, oblique=True,
+                            robot_radius=robot_radius, clearance=clearance.clear)
 
 
 def _checked_radii(robot_radius, obstacle_radius, obstacle_count):
