@@ -205,9 +205,10 @@ def choose_frame(obstacles: np.ndarray, bounds: np.ndarray | None = None,
     farthest obstacle along e2 (beyond its clearance, (r,) or one for all: the discs'
     PillarClearance), so with walls (bounds (d, 2)) the frame is the one with the most
     room there (_room: the area, or volume, of the robots' centres' box, robot_radius
-    inside the walls, beyond that); without walls, for bodies, the one whose farthest obstacle is nearest the
-    middle of the obstacles (_reach), an oblique frame only where it saves more than
-    robot_radius of that climb over every axis frame; otherwise the first, the coordinate
+    inside the walls, beyond that); without walls, for bodies, the one whose farthest
+    obstacle is nearest the middle of the obstacles (_reach), an oblique frame only where
+    it saves more than robot_radius of that climb over every axis frame; otherwise the
+    first, the coordinate
     axes when they separate the obstacles (e1 = x, e2 = y). Ties go to the first, the
     axis frames first. With no axis frame separating the obstacles, the moment-curve
     direction that maximises the smallest gap between their projections, e2 across it
