@@ -132,6 +132,27 @@ def test_markers_name_every_part():
         assert sorted(set(ends[..., 0].ravel())) == [-4.0, 4.0]
 
 
+@pytest.mark.parametrize('dimension', [2, 3])
+def test_an_obstacle_with_a_radius_is_drawn_as_its_body(dimension):
+    """A pillar in the plane: a cylinder standing on it; a ball in space: the ball itself."""
+    plan = core_plan(dimension=dimension, variant='discs', robot_radius=0.1,
+                     obstacle_radius=0.2)
+    pillars = [m for m in publications.plan_markers(plan, 'map', 0, 0.5).markers
+               if m.ns == 'pillars']
+    centres = conversions.to_xyz(plan.workspace.obstacles, 0.5).reshape(-1, 3)
+    assert len(pillars) == len(centres)
+    for pillar, centre in zip(pillars, centres):
+        middle = np.array([pillar.pose.position.x, pillar.pose.position.y,
+                           pillar.pose.position.z])
+        size = (pillar.scale.x, pillar.scale.y, pillar.scale.z)
+        if dimension == 3:
+            assert pillar.type == pillar.SPHERE and size == (0.4, 0.4, 0.4)
+            assert np.array_equal(middle, centre)
+        else:
+            assert pillar.type == pillar.CYLINDER and size[:2] == (0.4, 0.4)
+            assert np.array_equal(middle, centre + [0.0, 0.0, 0.5 * size[2]])
+
+
 def reference_paths(samples, orientations, frame_id, start_ns, plane_z=0.0):
     """Return the Paths as conversions built them before issue 13 (constructed messages)."""
     from geometry_msgs.msg import PoseStamped

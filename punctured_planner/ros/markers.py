@@ -85,19 +85,27 @@ def plan_markers(plan: Plan, frame_id: str, stamp_ns: int, plane_z: float = 0.0,
 
 
 def _obstacle_markers(drawing: _Drawing, workspace: Workspace) -> list[Marker]:
-    """Return the obstacles' spheres and, for those with a radius, their pillars."""
+    """
+    Return the obstacles' spheres and, for those with a radius, their bodies.
+
+    In the plane an obstacle with a radius is a pillar, drawn as a cylinder
+    PILLAR_HEIGHT high standing on the plane; in space a ball, drawn as itself.
+    """
     obstacles = to_xyz(workspace.obstacles, drawing.plane_z).reshape(-1, 3)
     markers = []
     if len(obstacles):
         markers.append(drawing.marker('obstacles', 0, Marker.SPHERE_LIST, _rgba(*_BLACK),
                                       0.25 * drawing.scale, obstacles))
+    ball = workspace.dimension >= 3
     for j, radius in enumerate(workspace.obstacle_radii.tolist()):
-        if radius > 0:  # the pillar's body: a cylinder of its diameter
-            pillar = drawing.marker('pillars', j, Marker.CYLINDER, _rgba(0.3, 0.3, 0.3, 0.6),
-                                    2 * radius)
-            pillar.scale.z = PILLAR_HEIGHT
-            pillar.pose.position.x, pillar.pose.position.y = obstacles[j, :2].tolist()
-            pillar.pose.position.z = float(obstacles[j, 2]) + 0.5 * PILLAR_HEIGHT
+        if radius > 0:  # the body: a ball, or a pillar's cylinder, of its diameter
+            pillar = drawing.marker('pillars', j, Marker.SPHERE if ball else Marker.CYLINDER,
+                                    _rgba(0.3, 0.3, 0.3, 0.6), 2 * radius)
+            pillar.pose.position.x, pillar.pose.position.y, pillar.pose.position.z = (
+                obstacles[j].tolist())
+            if not ball:
+                pillar.scale.z = PILLAR_HEIGHT
+                pillar.pose.position.z += 0.5 * PILLAR_HEIGHT
             markers.append(pillar)
     return markers
 
