@@ -236,6 +236,33 @@ def test_errors_carry_their_culprits_and_are_worded_by_the_layer_that_answers():
         '(from topic /fleet/obstacles) are at the same point')
 
 
+def test_the_parameters_hint_says_how_to_change_obstacles_and_radii_together():
+    """
+    The hint to set both atomically comes only where one of the two changed alone.
+
+    A parameter set (ros2 param set, ros2 param load) applies one at a time, so four
+    obstacles against three radii are refused; at start-up (every parameter changed)
+    and for a pillar beyond a wall the hint has nothing to say.
+    """
+    three = [0.0, 0.0, 0.0, 2.0, 1.0, 0.0, -2.0, -1.0, 0.0]
+    settings = PLANNER.settings({'robot_radius': 0.2, 'obstacle_radius': [0.1, 0.2, 0.3],
+                                 'obstacles': three + [3.0, 3.0, 0.0]})
+    four = ObstacleSet(conversions.obstacles_from_parameter(settings.obstacles))
+    handler = PlanSequenceHandler()
+    for changed, hinted in (({'obstacles'}, True), ({'obstacles', 'obstacle_radius'}, False)):
+        with pytest.raises(ValueError) as refused:
+            handler.check_parameter_obstacles(settings, four, changed)
+        assert 'obstacle_radius must be a scalar or one value per obstacle' in str(refused.value)
+        assert ('set_parameters_atomically' in str(refused.value)) == hinted
+    walled = PLANNER.settings({'robot_radius': 0.2, 'obstacle_radius': [0.3],
+                               'obstacles': three, 'workspace_bounds': [-5, 5, -0.5, 5]})
+    with pytest.raises(ValueError) as refused:
+        handler.check_parameter_obstacles(walled, ObstacleSet(
+            conversions.obstacles_from_parameter(walled.obstacles)), {'obstacles'})
+    assert 'OUTSIDE_WORKSPACE' in str(refused.value) and 'y_min' in str(refused.value)
+    assert 'together' not in str(refused.value)
+
+
 def test_free_text_in_a_message_is_never_read_as_a_slot():
     """A frame id with braces is quoted as it is (the message is a template)."""
     outcome = answer(make_request(frame_id='{configuration}'), snapshot(), 0)

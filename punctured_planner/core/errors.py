@@ -163,7 +163,9 @@ class PlanningError(ValueError):
     words it. For OUTSIDE_WORKSPACE ``wall`` is the wall crossed (axis and
     side), ``distance`` how far the body reaches beyond it (> 0) and ``leg``
     the plan's leg (None for an input outside the bounds); for a plan that
-    leaves the bounds ``configuration`` is that leg's segment. ``message`` is
+    leaves the bounds ``configuration`` is that leg's segment. ``option`` is the
+    Workspace option whose value does not fit the others (obstacle_radius whose
+    count is not the obstacles'), where that is the fault. ``message`` is
     the template (module docstring); ``args[0]`` and ``str()`` are worded with
     the core's :class:`Names`.
     """
@@ -173,7 +175,7 @@ class PlanningError(ValueError):
                  obstacles: Iterable[int] = (), coordinate: int | None = None,
                  point: Any = None, clearance: Any = None, gap: Any = None,
                  wall: Wall | None = None, distance: float | None = None,
-                 leg: int | None = None) -> None:
+                 leg: int | None = None, option: str | None = None) -> None:
         """Store the code and the culprits; message is the reason's template."""
         self.code = ErrorCode(code)
         self.template = message
@@ -191,6 +193,7 @@ class PlanningError(ValueError):
         self.wall = wall
         self.distance = distance
         self.leg = leg
+        self.option = option
         super().__init__(self.describe(Names()))
 
     def describe(self, names: Names) -> str:

@@ -203,7 +203,8 @@ def _checked_radii(robot_radius, obstacle_radius, obstacle_count):
     if radii.shape != (obstacle_count,):
         raise PlanningError(ErrorCode.INVALID_REQUEST,
                             f'obstacle_radius must be a scalar or one value per obstacle '
-                            f'(shape ({obstacle_count},)), got shape {radii.shape}')
+                            f'(shape ({obstacle_count},)), got shape {radii.shape}',
+                            option='obstacle_radius')
     bad = np.flatnonzero(~lengths_in_range(radii, zero=True))
     if bad.size:
         raise PlanningError(ErrorCode.INVALID_REQUEST,

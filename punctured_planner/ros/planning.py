@@ -141,9 +141,13 @@ class PlanSequenceHandler:
             (self.check_obstacles if 'obstacles' in changed
              else self.check_workspace)(settings, obstacles)
         except PlanningError as error:
-            hint = ('; to change obstacles and obstacle_radius together, set both in one call '
-                    '(ros2 param load) or make obstacle_radius one value first'
-                    if changed & {'obstacles', 'obstacle_radius'} else '')
+            # One of the two changed alone, and their counts no longer fit: a set of
+            # parameters (ros2 param set, ros2 param load) applies one at a time.
+            hint = ('; to change obstacles and obstacle_radius together, set both '
+                    'atomically (the set_parameters_atomically service) or make '
+                    'obstacle_radius one value first'
+                    if error.option == 'obstacle_radius'
+                    and len(changed & {'obstacles', 'obstacle_radius'}) == 1 else '')
             raise ValueError('%s with %s: %s%s' % (
                 error.code.name, obstacles.describe(),
                 error.describe(ObstacleNames(obstacles.name)), hint)) from None
