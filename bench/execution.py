@@ -85,15 +85,14 @@ def simulate(the_plan, slow, late, shared_clock, **settings):
     from punctured_planner.execution import Execution
     from punctured_planner.execution import ExecutionSettings
     from punctured_planner.execution import Reference
-    from punctured_planner.execution import tracking_tolerance
     from punctured_planner.sim import Fleet
     from punctured_planner.sim import FleetSettings
     positions = xyz(the_plan.positions)
     reference = Reference.timed(the_plan.stamps(SPEED, ACCELERATION), positions,
                                 np.tile([0.0, 0.0, 0.0, 1.0], positions.shape[:2] + (1,)),
-                                SPEED, ACCELERATION, the_plan.min_gap)
+                                SPEED, ACCELERATION, the_plan.tracking_tolerance)
     bodies = Bodies(RADIUS, xyz(OBSTACLES), np.zeros(len(OBSTACLES)))
-    tolerance = tracking_tolerance(the_plan.min_gap, the_plan.wall_gap)
+    tolerance = the_plan.tracking_tolerance
     fleet = Fleet(positions[0], FleetSettings(
         bodies=bodies, speed_limit=SPEED, speed_factors=speed_factors(slow),
         latencies=np.where(np.arange(K) == late, LATENCY, 0.0), velocity_noise=NOISE,
@@ -380,10 +379,9 @@ def stale_and_cancel(the_plan, slow, late):
 
 def report(the_plan, rows, slow, late, shared, unshared, cancel, differential):
     """Return the Markdown of bench/execution.md."""
-    from punctured_planner.execution import tracking_tolerance
     nominal = the_plan.duration(SPEED, ACCELERATION)
     at_slow = the_plan.duration(SPEED * 0.5, ACCELERATION)
-    tolerance = tracking_tolerance(the_plan.min_gap, the_plan.wall_gap)
+    tolerance = the_plan.tracking_tolerance
     bound = straight_bound(the_plan, slow)
     fleet_bound = float(straight_times(the_plan, slow).max())
     lines = [
@@ -513,13 +511,12 @@ def main(argv=None):
     os.environ.setdefault('ROS_LOG_DIR', tempfile.mkdtemp(prefix='pp_execution_log_'))
     the_plan = core_plan()
     if args.drives:
-        from punctured_planner.execution import tracking_tolerance
         shared = dds_run(the_plan, 0, 1, True, 'shared')
         print('DDS shared clock:', shared, flush=True)
         differential = dds_run(the_plan, 0, 1, True, 'diff', 'differential')
         print('DDS differential:', differential, flush=True)
         print(differential_line(differential, shared,
-                                tracking_tolerance(the_plan.min_gap, the_plan.wall_gap)))
+                                the_plan.tracking_tolerance))
         return 0
     rows = sweep(the_plan, args.quick)
     for row in rows:

@@ -129,14 +129,14 @@ def test_profile_respects_both_limits_and_every_corner(line, speed, acceleration
 
 @settings(max_examples=100, deadline=None)
 @given(polylines, st.integers(0, 2 ** 32 - 1), st.floats(0.0, 1.0))
-def test_fleet_profile_keeps_every_robot_within_its_own_limits(line, seed, gap):
+def test_fleet_profile_keeps_every_robot_within_its_own_limits(line, seed, tolerance):
     """Robot i: speed <= its v_i, acceleration <= its a_i, corner jumps <= its J_i; stops."""
     positions = random_polyline(*line)
     rng = np.random.default_rng(seed)
     k = positions.shape[1]
     speeds, accelerations = rng.uniform(0.05, 2.0, k), rng.uniform(0.05, 2.0, k)
     stops = rng.uniform(size=len(positions)) < 0.2
-    profile = fleet_profile(positions, speeds, accelerations, gap, stops)
+    profile = fleet_profile(positions, speeds, accelerations, tolerance, stops)
     assert profile.speeds[0] == 0.0 and profile.speeds[-1] == 0.0
     assert np.all(profile.speeds[stops] == 0.0)
     lengths = profile.lengths
@@ -151,21 +151,21 @@ def test_fleet_profile_keeps_every_robot_within_its_own_limits(line, seed, gap):
             assert np.all(rates * abs(state.acceleration) <= accelerations + 1e-9)
     rates = steps[moving] / lengths[moving][:, None, None]
     jumps = np.linalg.norm(np.diff(rates, axis=0), axis=2) * profile.speeds[moving[1:], None]
-    allowed = np.array([corner_jump(a, gap) for a in accelerations])
+    allowed = np.array([corner_jump(a, tolerance) for a in accelerations])
     assert np.all(jumps <= allowed + 1e-9)
 
 
 @settings(max_examples=50, deadline=None)
 @given(polylines, st.floats(0.05, 5.0), st.floats(0.05, 5.0), st.floats(0.0, 1.0))
 def test_fleet_profile_at_the_plans_limits_is_the_plans_profile(
-        line, speed, acceleration, gap):
+        line, speed, acceleration, tolerance):
     """Every robot at max_speed and max_acceleration, no stop: the planner's own stamps."""
     positions = random_polyline(*line)
     k = positions.shape[1]
     plan_stamps = speed_profile(positions, speed, acceleration,
-                                corner_jump(acceleration, gap)).stamps()
+                                corner_jump(acceleration, tolerance)).stamps()
     fleet_stamps = fleet_profile(positions, np.full(k, speed), np.full(k, acceleration),
-                                 gap).stamps()
+                                 tolerance).stamps()
     assert np.allclose(fleet_stamps, plan_stamps, rtol=1e-9, atol=1e-9)
 
 
@@ -196,10 +196,11 @@ def test_resampled_stamps_follow_the_profile_and_keep_every_breakpoint():
     xyz = np.concatenate([samples.positions, np.zeros(samples.positions.shape[:2] + (1,))], -1)
     reference = Reference.timed(samples.values, xyz,
                                 np.tile([0.0, 0.0, 0.0, 1.0], xyz.shape[:2] + (1,)), 1.0, 1.0,
-                                p.min_gap)
+                                p.tracking_tolerance)
     breakpoints = Reference.timed(stamps, np.concatenate(
         [p.positions, np.zeros(p.positions.shape[:2] + (1,))], -1),
-        np.tile([0.0, 0.0, 0.0, 1.0], p.positions.shape[:2] + (1,)), 1.0, 1.0, p.min_gap)
+        np.tile([0.0, 0.0, 0.0, 1.0], p.positions.shape[:2] + (1,)), 1.0, 1.0,
+        p.tracking_tolerance)
     for s in np.linspace(0.0, stamps[-1], 301):
         assert np.allclose(reference.position(s), breakpoints.position(s), atol=1e-7)
         assert np.allclose(reference.velocity(s), breakpoints.velocity(s), atol=1e-5)
@@ -212,7 +213,7 @@ def test_timed_reference_is_exact_at_stamps_and_followable_between():
     xyz = np.concatenate([samples.positions, np.zeros(samples.positions.shape[:2] + (1,))], -1)
     reference = Reference.timed(samples.values, xyz,
                                 np.tile([0.0, 0.0, 0.0, 1.0], xyz.shape[:2] + (1,)), 1.0, 0.8,
-                                p.min_gap)
+                                p.tracking_tolerance)
     for j, s in enumerate(samples.values):
         assert np.array_equal(reference.position(s), xyz[j])
     times = np.linspace(0.0, reference.duration, 4001)
@@ -222,5 +223,5 @@ def test_timed_reference_is_exact_at_stamps_and_followable_between():
     assert np.linalg.norm(accelerations, axis=2).max() <= 0.8 + 1e-9
     jumps = np.linalg.norm(np.diff(velocities, axis=0), axis=2).max(axis=1)
     # between grid points a velocity changes by a dt, or by at most a corner's jump
-    assert jumps.max() <= corner_jump(0.8, p.min_gap) + 0.8 * np.diff(times)[0] + 1e-9
+    assert jumps.max() <= corner_jump(0.8, p.tracking_tolerance) + 0.8 * np.diff(times)[0] + 1e-9
     assert np.array_equal(reference.velocity(reference.duration), np.zeros((4, 3)))

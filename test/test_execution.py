@@ -11,12 +11,12 @@ from hypothesis import strategies as st
 import numpy as np
 from punctured_planner.core import plan
 from punctured_planner.core import Workspace
+from punctured_planner.core.timing import tracking_tolerance
 from punctured_planner.execution import Bodies
 from punctured_planner.execution import clock_rate
 from punctured_planner.execution import Execution
 from punctured_planner.execution import ExecutionSettings
 from punctured_planner.execution import Reference
-from punctured_planner.execution import tracking_tolerance
 from punctured_planner.execution.execution import ACCELERATION_SHARE
 from punctured_planner.execution.execution import saturate
 from punctured_planner.sim import Fleet
@@ -140,7 +140,7 @@ def certified_fleet(k=6, seed=2, acceleration=0.0):
     gap = core.min_clearance - 2 * radius
     reference = Reference.timed(core.stamps(0.5, acceleration), positions,
                                 np.tile(IDENTITY, positions.shape[:2] + (1,)), 0.5,
-                                acceleration, gap)
+                                acceleration, tracking_tolerance(gap, np.inf))
     return reference, bodies, gap
 
 
@@ -253,7 +253,7 @@ def test_clock_speeds_up_within_the_plans_acceleration_limit():
     """After a hold the clock rises by at most h a dt / |r'| per step; without a limit at once."""
     positions = np.array([[[0.0, 0.0, 0.0]], [[10.0, 0.0, 0.0]]])
     timed = Reference.timed(np.array([0.0, 11.0]), positions,
-                            np.tile(IDENTITY, (2, 1, 1)), 1.0, 1.0, 1.0)
+                            np.tile(IDENTITY, (2, 1, 1)), 1.0, 1.0, 0.5)
     assert timed.duration == pytest.approx(11.0)
     execution = Execution(timed, 0.5, ExecutionSettings(speed_limit=2.0))
     own = execution.reference
@@ -275,7 +275,7 @@ def test_feedforward_includes_the_references_acceleration():
     """On a speeding-up reference the command leads the velocity by a x rate^2 x dt."""
     positions = np.array([[[0.0, 0.0, 0.0]], [[10.0, 0.0, 0.0]]])
     timed = Reference.timed(np.array([0.0, 11.0]), positions,
-                            np.tile(IDENTITY, (2, 1, 1)), 1.0, 1.0, 1.0)
+                            np.tile(IDENTITY, (2, 1, 1)), 1.0, 1.0, 0.5)
     execution = Execution(timed, 0.5, ExecutionSettings(speed_limit=2.0, gain=0.0,
                                                         feedforward_adaptation=0.0))
     own = execution.reference
@@ -526,7 +526,7 @@ def test_retimed_reference_keeps_the_poses_and_each_robots_own_speed():
         k = reference.robot_count
         speeds = np.where(np.arange(k) == 0, 0.25, 0.5)
         accelerations = np.where(np.arange(k) == 0, 0.5, 1.0)
-        retimed = reference.retimed(speeds, accelerations, gap)
+        retimed = reference.retimed(speeds, accelerations, tracking_tolerance(gap, np.inf))
         assert np.array_equal(retimed.positions, reference.positions)
         assert retimed.duration > reference.duration
         times = np.linspace(0.0, retimed.duration, 3001)
@@ -537,7 +537,8 @@ def test_retimed_reference_keeps_the_poses_and_each_robots_own_speed():
                                for s in times])
             assert np.all(change <= accelerations + 1e-6)
         # limits above the plan's change nothing: its own profile's stamps
-        same = reference.retimed(np.full(k, 9.0), np.full(k, 9.0), gap)
+        same = reference.retimed(np.full(k, 9.0), np.full(k, 9.0),
+                                 tracking_tolerance(gap, np.inf))
         own = reference.profile.stamps() if acceleration else reference.seconds
         assert np.allclose(same.seconds, own, atol=1e-9)
 

@@ -269,7 +269,7 @@ def test_a_timed_plan_stops_where_a_differential_robot_switches_direction():
     positions = np.array([[[0, 0, 0], [0, 2, 0]], [[2, 0, 0], [2, 2, 0]],
                           [[0, 2, 0], [4, 2, 0]]], dtype=float)
     orientations = np.tile([0.0, 0.0, 0.0, 1.0], (3, 2, 1))
-    timed = Reference.timed(np.array([0.0, 3.0, 6.0]), positions, orientations, 1.0, 1.0, 0.5)
+    timed = Reference.timed(np.array([0.0, 3.0, 6.0]), positions, orientations, 1.0, 1.0, 0.25)
     assert timed.profile.speeds[1] > 0, 'the plan passes its corner moving'
     holonomic = Execution(timed, 0.25, ExecutionSettings(speed_limit=1.0))
     assert holonomic.reference.at_rest().tolist() == [True, False, True], 'no stop'
@@ -285,7 +285,7 @@ def test_a_timed_plan_stops_where_a_differential_robot_switches_direction():
     # a right angle is followed moving, slowed into by the corner ramp
     right = positions.copy()
     right[2, 0] = [2, 2, 0]
-    square = Reference.timed(np.array([0.0, 3.0, 6.0]), right, orientations, 1.0, 1.0, 0.5)
+    square = Reference.timed(np.array([0.0, 3.0, 6.0]), right, orientations, 1.0, 1.0, 0.25)
     bent = Execution(square, 0.25, ExecutionSettings(drive=drive, speed_limit=1.0,
                                                      yaw_rate_limit=1.9))
     assert bent.reference.at_rest().tolist() == [True, False, True]
@@ -294,6 +294,6 @@ def test_a_timed_plan_stops_where_a_differential_robot_switches_direction():
     # the differential robot straight, the holonomic one turning: no stop
     straight = positions.copy()
     straight[2] = [[4, 0, 0], [2, 4, 0]]
-    plain = Reference.timed(np.array([0.0, 3.0, 6.0]), straight, orientations, 1.0, 1.0, 0.5)
+    plain = Reference.timed(np.array([0.0, 3.0, 6.0]), straight, orientations, 1.0, 1.0, 0.25)
     assert Execution(plain, 0.25, ExecutionSettings(drive=drive)).reference.at_rest(
     ).tolist() == [True, False, True]

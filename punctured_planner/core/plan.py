@@ -32,7 +32,7 @@ from .sections import compose, lane_heights, SCHEDULES, segment_times
 from .space import Workspace
 from .strata import epsilon, projection_count, projection_gaps
 from .timing import (corner_jump, leg_at, length_times, resample, speed_profile, SpeedProfile,
-                     stamps as timed_stamps)
+                     stamps as timed_stamps, tracking_tolerance)
 from .validation import validate_configurations
 from .walls import smallest_leg_slack, WallSlack
 
@@ -191,6 +191,11 @@ class Plan:
         """Return the smallest gap of a robot's body to a wall over the motion (inf: no walls)."""
         return np.inf if self.wall_slack is None else self.wall_slack.slack
 
+    @property
+    def tracking_tolerance(self) -> float:
+        """Return how far each robot may stray from its reference: min(min_gap / 2, wall_gap)."""
+        return tracking_tolerance(self.min_gap, self.wall_gap)
+
     def segment_of(self, leg: int) -> int:
         """Return m, 0-based, of the segment C_{m+1} -> C_{m+2} that leg [leg, leg + 1] is in."""
         return int(np.searchsorted(self.waypoint_indices, leg, side='right')) - 1
@@ -270,7 +275,8 @@ class Plan:
         the repeated ones, which leaves every stamp as it is.
         """
         return speed_profile(self.positions if positions is None else positions, max_speed,
-                             max_acceleration, corner_jump(max_acceleration, self.min_gap))
+                             max_acceleration,
+                             corner_jump(max_acceleration, self.tracking_tolerance))
 
     def stamps(self, max_speed: float, max_acceleration: float = 0.0) -> np.ndarray:
         """
@@ -284,9 +290,10 @@ class Plan:
         key = (float(max_speed), float(max_acceleration))
         found = self._stamps.get(key)
         if found is None:
-            # the gap only matters to the corners of a limited profile: no certificate for 0
+            # the tolerance only matters to the corners of a limited profile: no certificate
+            # for 0
             found = timed_stamps(self.positions, max_speed, max_acceleration,
-                                 self.min_gap if max_acceleration else 0.0)
+                                 self.tracking_tolerance if max_acceleration else 0.0)
             found.flags.writeable = False
             self._stamps[key] = found
         return found

@@ -70,15 +70,28 @@ def breakpoint_stamps(positions: np.ndarray, max_speed: float) -> np.ndarray:
     return stamps
 
 
-def corner_jump(max_acceleration: float, min_gap: float) -> float:
+def tracking_tolerance(min_gap: float, wall_gap: float) -> float:
+    """
+    Return delta = min(min_gap / 2, wall_gap): the largest safe deviation from a reference.
+
+    Two bodies each within delta of their references close by at most 2 delta <=
+    min_gap, a body and a pillar by delta; a body and a wall (its reference wall_gap
+    from it) by delta <= wall_gap: a robot within the tolerance that ignored the walls
+    could touch a wall its reference passes closer than min_gap / 2 (doc/design.md
+    section 13). The timing law spends a share of it on the corners (corner_jump).
+    """
+    return min(0.5 * float(min_gap), float(wall_gap))
+
+
+def corner_jump(max_acceleration: float, tolerance: float) -> float:
     """
     Return the largest velocity jump (m/s) a corner may give any robot of a plan.
 
     A robot that accelerates at max_acceleration toward a velocity that
     jumped by dv lags it by dv^2 / (2 a); this is the dv for which that lag is
-    CORNER_SHARE of the tracking tolerance delta = min_gap / 2.
+    CORNER_SHARE of the tracking tolerance delta (tracking_tolerance).
     """
-    return float(np.sqrt(2.0 * max_acceleration * CORNER_SHARE * max(min_gap, 0.0) / 2.0))
+    return float(np.sqrt(2.0 * max_acceleration * CORNER_SHARE * max(tolerance, 0.0)))
 
 
 @dataclass(frozen=True)
@@ -187,7 +200,7 @@ def speed_profile(positions: np.ndarray, max_speed: float, max_acceleration: flo
 
 
 def fleet_profile(positions: np.ndarray, max_speeds: np.ndarray,
-                  max_accelerations: np.ndarray, min_gap: float,
+                  max_accelerations: np.ndarray, tolerance: float,
                   stops: np.ndarray | None = None) -> SpeedProfile:
     """
     Return the fastest SpeedProfile of positions (V, k, d) for each robot's own limits.
@@ -212,7 +225,7 @@ def fleet_profile(positions: np.ndarray, max_speeds: np.ndarray,
         leg_speeds = np.where(rates > 0, max_speeds / rates, np.inf).min(axis=1)
         leg_accelerations = np.where(rates > 0, max_accelerations / rates,
                                      np.inf).min(axis=1)
-    jumps = np.array([corner_jump(a, min_gap) for a in max_accelerations])
+    jumps = np.array([corner_jump(a, tolerance) for a in max_accelerations])
     # a leg in which nothing moves has no limit; its value is never used
     fallback = float(max_speeds.max()), float(max_accelerations.max())
     leg_speeds = np.where(np.isfinite(leg_speeds), leg_speeds, fallback[0])
@@ -259,18 +272,18 @@ def _breakpoint_speeds(positions: np.ndarray, lengths: np.ndarray, leg_speeds: n
 
 
 def stamps(positions: np.ndarray, max_speed: float, max_acceleration: float,
-           min_gap: float) -> np.ndarray:
+           tolerance: float) -> np.ndarray:
     """
     Return (V,) seconds at each breakpoint of positions (V, k, d): the timing law.
 
     max_acceleration 0 (unlimited): each leg at max_speed throughout
     (:func:`breakpoint_stamps`); else the fastest SpeedProfile, its corners'
-    jumps from min_gap (:func:`corner_jump`).
+    jumps from the tracking tolerance (:func:`corner_jump`).
     """
     if max_acceleration == 0:
         return breakpoint_stamps(positions, max_speed)
     return speed_profile(positions, max_speed, max_acceleration,
-                         corner_jump(max_acceleration, min_gap)).stamps()
+                         corner_jump(max_acceleration, tolerance)).stamps()
 
 
 def resample(values: npt.ArrayLike, positions: np.ndarray, samples_per_leg: int,

@@ -190,7 +190,7 @@ class Execution:
         if speeds is not None or profile is not None:
             reference = reference.retimed(
                 np.full(k, np.inf) if speeds is None else speeds,
-                self.accelerations, 2.0 * self.tolerance, stops if stops.any() else None)
+                self.accelerations, self.tolerance, stops if stops.any() else None)
         self.reference = reference
         self.settings = settings
         self.bodies = bodies if bodies is not None else Bodies()

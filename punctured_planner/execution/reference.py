@@ -56,16 +56,21 @@ class Reference:
 
     @classmethod
     def timed(cls, seconds: np.ndarray, positions: np.ndarray, orientations: np.ndarray,
-              max_speed: float, max_acceleration: float, min_gap: float) -> 'Reference':
-        """Return the Reference of poses stamped under both limits (0: linear in time)."""
+              max_speed: float, max_acceleration: float, tolerance: float) -> 'Reference':
+        """
+        Return the Reference of poses stamped under both limits (0: linear in time).
+
+        The corners' velocity jumps come from the tracking tolerance, as the
+        planner's stamps (core.timing.corner_jump).
+        """
         if max_acceleration <= 0:
             return cls(seconds, positions, orientations)
         return cls(seconds, positions, orientations,
                    speed_profile(positions, max_speed, max_acceleration,
-                                 corner_jump(max_acceleration, min_gap)))
+                                 corner_jump(max_acceleration, tolerance)))
 
     def retimed(self, max_speeds: np.ndarray, max_accelerations: np.ndarray,
-                min_gap: float, stops: np.ndarray | None = None) -> 'Reference':
+                tolerance: float, stops: np.ndarray | None = None) -> 'Reference':
         """
         Return the same motion timed so that robot i needs at most its own limits (k,).
 
@@ -85,7 +90,7 @@ class Reference:
                              self.orientations)
         profile = fleet_profile(self.positions, np.minimum(speeds, self.profile.max_speed),
                                 np.minimum(max_accelerations, self.profile.max_acceleration),
-                                min_gap, stops)
+                                tolerance, stops)
         return Reference(profile.stamps(), self.positions, self.orientations, profile)
 
     def at_rest(self) -> np.ndarray:

@@ -7,7 +7,8 @@ distance - R - rho for a robot and an obstacle). If at plan time s every robot
 is within delta of its reference position, each centre distance differs from
 the reference one by at most 2 delta (triangle inequality; an obstacle does not
 move, so at most delta there), so every gap is at least g - 2 delta. With
-delta = g / 2 the bodies cannot touch: that delta is the tracking tolerance.
+delta = g / 2 the bodies cannot touch: that delta is the tracking tolerance
+(core.timing.tracking_tolerance, less where a wall is nearer).
 The shared clock keeps every robot inside it: full speed while the largest
 error is at most ``slow_fraction`` delta, slower in between, held from
 ``hold_fraction`` delta on; the margin (1 - hold_fraction) delta covers what a
@@ -15,18 +16,6 @@ robot can move in one control step and its command latency.
 """
 
 import numpy as np
-
-
-def tracking_tolerance(min_gap: float, wall_gap: float) -> float:
-    """
-    Return delta = min(min_gap / 2, wall_gap): the largest safe deviation from a reference.
-
-    Two bodies each within delta of their references close by at most 2 delta <=
-    min_gap, a body and a pillar by delta; a body and a wall (its reference wall_gap
-    from it) by delta <= wall_gap: a robot within the tolerance that ignored the walls
-    could touch a wall its reference passes closer than min_gap / 2.
-    """
-    return min(0.5 * float(min_gap), float(wall_gap))
 
 
 def clock_rate(errors: np.ndarray, tolerance: float, slow_fraction: float,

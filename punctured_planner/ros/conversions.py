@@ -65,7 +65,6 @@ from .snapshot import RobotOdometry
 from .. import core
 from ..execution import Bodies
 from ..execution import Reference
-from ..execution import tracking_tolerance
 
 IDENTITY = (0.0, 0.0, 0.0, 1.0)
 
@@ -368,7 +367,7 @@ def fill_response(response: PlanSequence.Response, plan: core.Plan, paths: Seque
     response.paths = paths
     response.waypoint_indices = [int(i) for i in np.asarray(waypoints).tolist()]
     response.dropped_configurations = [int(m) for m in dropped]
-    response.tracking_tolerance = tracking_tolerance(plan.min_gap, plan.wall_gap)
+    response.tracking_tolerance = plan.tracking_tolerance
     return response
 
 
@@ -478,7 +477,7 @@ def plan_reference(msg: Plan) -> Reference:
     positions = np.stack([a.positions for a in arrays], axis=1)
     orientations = normalized_quaternions(np.stack([a.orientations for a in arrays], axis=1))
     return Reference.timed(seconds, positions, orientations, float(msg.max_speed),
-                           float(msg.max_acceleration), float(msg.min_gap))
+                           float(msg.max_acceleration), float(msg.tracking_tolerance))
 
 
 def plan_numbers(msg: Plan) -> None:
