@@ -11,6 +11,8 @@ from hypothesis import strategies as st
 import numpy as np
 from punctured_planner.core import plan
 from punctured_planner.core import Workspace
+from punctured_planner.core.timing import corner_jump
+from punctured_planner.core.timing import speed_profile
 from punctured_planner.core.timing import tracking_tolerance
 from punctured_planner.execution import Bodies
 from punctured_planner.execution import clock_rate
@@ -488,6 +490,27 @@ def test_the_tracking_tolerance_keeps_the_robots_off_the_walls():
     message = conversions.plan_message(outcome, settings)
     assert message.tracking_tolerance == plan.wall_gap
     assert conversions.known_plan(message).tolerance == plan.wall_gap
+    # Under an acceleration limit the corners spend a share of that tolerance, in the
+    # planner's stamps and in the executor's rebuild of them alike (doc/design.md section 8).
+    limited = PLANNER.settings({**{spec: getattr(settings, spec) for spec in (
+        'obstacles', 'robot_radius', 'obstacle_radius', 'workspace_bounds')},
+        'max_acceleration': 0.8})
+    outcome = offline_plan(make_request(max_speed=0.5), limited, now_ns=10 ** 18)
+    samples = outcome.plan.sample(0, 0.5, 0.8)
+    reference = conversions.plan_reference(conversions.plan_message(outcome, limited))
+    assert np.allclose(reference.profile.stamps(), samples.values, atol=1e-8)
+    budgets = {delta: speed_profile(reference.positions, 0.5, 0.8, corner_jump(0.8, delta))
+               for delta in (plan.wall_gap, plan.min_gap / 2)}
+    assert np.allclose(budgets[plan.wall_gap].stamps(), samples.values, atol=1e-8)
+    assert budgets[plan.min_gap / 2].stamps()[-1] < samples.values[-1] - 0.1
+    # at every corner between two legs of a real length, a jump within the budget (an ulp
+    # leg between two corners merges them: doc/design.md section 8)
+    legs = np.linalg.norm(np.diff(reference.positions, axis=0), axis=2).max(axis=1)
+    corners = np.flatnonzero((legs[:-1] > 1e-9) & (legs[1:] > 1e-9)) + 1
+    jumps = [np.linalg.norm(reference.velocity(reference.seconds[j] + 1e-7)
+                            - reference.velocity(reference.seconds[j] - 1e-7), axis=1).max()
+             for j in corners]
+    assert max(jumps) <= corner_jump(0.8, plan.wall_gap) + 1e-6
 
 
 def test_plan_message_carries_the_acceleration_limit_to_the_executor():
