@@ -257,8 +257,13 @@ def test_plan_to_motion_over_dds(graph):
     assert client.spin_until(lambda: feedback and feedback[-1][1].plan_time > 1.0, 20)
     graph.set_sim(muted_robots=['r2'])
     assert client.spin_until(lambda: feedback[-1][1].stale_robots == ['r2'], 5), graph.logs()
+    stale_at = feedback[-1][1].plan_time
+    # the clock brakes within the plan's acceleration limit (0.6 of 1 m/s^2: 1.7 s from
+    # 1 m/s at most, 0.83 s of plan time), then holds
+    assert client.spin_until(lambda: feedback[-1][1].clock_rate == 0.0, 3), graph.logs()
     held = feedback[-1][1].plan_time
-    client.spin_until(lambda: False, 1.0)
+    assert stale_at <= held < stale_at + 1.0
+    client.spin_until(lambda: False, 0.5)
     assert feedback[-1][1].plan_time == held and feedback[-1][1].clock_rate == 0.0
     graph.set_sim(muted_robots=[])
     assert client.spin_until(lambda: feedback[-1][1].plan_time > held + 0.5, 10)

@@ -253,7 +253,8 @@ class ExecutorSettings:
     odom_timeout: float = Spec(
         'odom_timeout', 'double', 0.5,
         "A robot's odometry older than this (s, by arrival) is stale: the clock holds "
-        'and the robot gets zero velocity until it is back.', low=1e-3, high=1e3).field()
+        "(braking within the plan's acceleration limit, the stale robot on its "
+        'feed-forward alone) until it is back.', low=1e-3, high=1e3).field()
     discovery_timeout: float = Spec(
         'discovery_timeout', 'double', 5.0,
         'How long a new goal waits for odometry from every robot of the plan before it '
