@@ -141,7 +141,7 @@ demo: setup
 # Discovery stays on this machine unless ROS_AUTOMATIC_DISCOVERY_RANGE says otherwise.
 run: setup
 	@export ROS_AUTOMATIC_DISCOVERY_RANGE=$${ROS_AUTOMATIC_DISCOVERY_RANGE:-LOCALHOST}; \
-	if [ -f '$(PARAMS)' ]; then \
+	if [ -n '$(PARAMS)' ]; then \
 	  echo '==> $(VENV)/bin/planner_node --ros-args --params-file $(PARAMS)'; \
 	  exec $(VENV)/bin/planner_node --ros-args --params-file '$(PARAMS)'; \
 	else \

@@ -85,6 +85,35 @@ def test_invalid_parameters_stop_the_node(planner_process, arguments):
     assert 'invalid parameters' in node.log()
 
 
+@pytest.mark.parametrize('content, reason', [
+    (None, 'No such file or directory'),
+    ('a: [\n', 'not YAML'),
+    ('/**/planner_node:\n  ros__parameters:\n    robot_radiuss: 0.2\n',
+     "unknown parameter 'robot_radiuss' of planner_node"),
+    ('/**/planer_node:\n  ros__parameters:\n    robot_radius: 0.2\n',
+     'no section applies to planner_node'),
+], ids=['missing', 'not-yaml', 'misspelt-name', 'misspelt-section'])
+def test_a_parameter_file_the_node_cannot_use_stops_it(planner_process, tmp_path, content,
+                                                       reason):
+    """
+    Exit 2 and the reason, as ``punctured-planner plan --params`` says it.
+
+    rcl raised a traceback (exit 1) for a file it cannot read; a misspelt name or
+    section started the node on its defaults without a word.
+    """
+    path = tmp_path / 'params.yaml'
+    if content is not None:
+        path.write_text(content)
+    node = planner_process(params_file=path)
+    try:
+        code = node.proc.wait(timeout=60)
+    except subprocess.TimeoutExpired:
+        pytest.fail('planner_node kept running with %s:\n%s' % (content, node.log()))
+    assert code == 2, node.log()
+    assert 'invalid parameters' in node.log() and reason in node.log(), node.log()
+    assert 'Traceback' not in node.log()
+
+
 def test_renamed_node_keeps_its_companion_apart(planner_process, ros_client):
     """Under -r __node:=NAME (a launch name=) the companions are NAME_server, _inputs, _outputs."""
     from punctured_planner_interfaces.srv import PlanSequence

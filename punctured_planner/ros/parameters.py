@@ -22,6 +22,7 @@ from typing import Any
 from typing import Callable
 from typing import Generic
 from typing import Iterable
+from typing import Sequence
 from typing import TypeVar
 
 import numpy as np
@@ -251,6 +252,37 @@ class Table(Generic[S]):
             assert item.name == spec.name, (item.name, spec.name)
         self.by_name = {spec.name: spec for spec in self.specs}
         self._checks = checks
+
+    def check_files(self, arguments: Sequence[str]) -> None:
+        """
+        Raise ValueError for a --params-file of a node's command line the node cannot use.
+
+        rcl refuses a file it cannot parse, with a traceback; a node starts on its
+        defaults from a file none of whose sections applies to it, and ignores a
+        misspelt name in its own section (robot_radiuss). All are refused here with
+        the reason, as ``punctured-planner plan --params`` refuses them
+        (load_parameter_file). The values are the node's to check when it declares
+        them. A command line that renames the node (__node:=) is not checked: its
+        sections carry the new name.
+        """
+        arguments = list(arguments)
+        if any(argument.startswith(('__node:=', '__name:=')) for argument in arguments):
+            return
+        paths = [arguments[i + 1] for i, argument in enumerate(arguments[:-1])
+                 if argument == '--params-file']
+        for path in paths:
+            try:
+                values = load_parameter_file(path, self)
+            except OSError as error:
+                raise ValueError('--params-file %s: %s' % (path, error.strerror)) from None
+            except yaml.YAMLError as error:
+                raise ValueError('--params-file %s: not YAML: %s' % (
+                    path, ' '.join(str(error).split()))) from None
+            unknown = sorted(set(values) - set(self.by_name))
+            if unknown:
+                raise ValueError('%s: unknown parameter %r of %s (parameters: %s)'
+                                 % (path, unknown[0], self.node_name,
+                                    ', '.join(self.by_name)))
 
     def settings(self, values: dict) -> S:
         """

@@ -89,6 +89,7 @@ from typing import Optional
 from typing import Sequence
 
 import rclpy
+from rclpy._rclpy_pybind11 import RCLError
 from rclpy.action import ActionServer
 from rclpy.context import Context
 from rclpy.exceptions import ParameterException
@@ -102,6 +103,7 @@ from rclpy.service import Service
 from rclpy.signals import SignalHandlerOptions
 from rclpy.task import Future
 
+from .parameters import Table
 from .qos import load_fastdds_profile
 from .qos import SERVER_QOS
 
@@ -423,21 +425,34 @@ class ExecutorThreads:
 
 
 def run_nodes(name: str, make_nodes: Callable[[Context], NodeGroup],
-              args: Optional[List[str]] = None, timeout_sec: float = STOP_TIMEOUT_SEC) -> int:
+              args: Optional[List[str]] = None, timeout_sec: float = STOP_TIMEOUT_SEC,
+              parameters: Optional[Table] = None) -> int:
     """
     Run a process's nodes until SIGINT or SIGTERM, stop them cleanly; return the exit code.
 
-    The whole ``main()`` of a node process (see the module docstring):
-    initialise a Context with ``args``, call ``make_nodes(context)``, spin each
-    node in its thread, wait for a stop signal, stop. Returns 0 after a
+    The whole ``main()`` of a node process (see the module docstring): check
+    the parameter files of ``args`` (sys.argv when None) against the node's
+    ``parameters`` table (Table.check_files), initialise a Context with them,
+    call ``make_nodes(context)``, spin each node in its thread, wait for a
+    stop signal, stop. Returns 0 after a
     signal, 1 when a callback raised, 2 (with the reason on stderr, after
-    ``name: invalid parameters:``) when ``make_nodes`` refused its parameters.
-    Call it from the main thread.
+    ``name: invalid parameters:``) for a parameter file the node cannot use,
+    arguments rcl refuses, or parameters ``make_nodes`` refused. Call it from
+    the main thread.
     """
     with StopSignals() as signals:
         load_fastdds_profile()
         context = Context()
-        rclpy.init(args=args, context=context, signal_handler_options=SignalHandlerOptions.NO)
+        try:
+            if parameters is not None:
+                parameters.check_files(sys.argv if args is None else args)
+            rclpy.init(args=args, context=context,
+                       signal_handler_options=SignalHandlerOptions.NO)
+        except (ValueError, RCLError) as error:
+            # rcl's reason without its source locations (', at /project/src/...')
+            print('%s: invalid parameters: %s' % (name, str(error).split(', at ')[0]),
+                  file=sys.stderr)
+            return EXIT_BAD_PARAMETERS
         try:
             try:
                 group = make_nodes(context)
