@@ -391,6 +391,26 @@ def test_parameters_over_the_parameter_service(planner, ros_client):
     assert described.additional_constraints
 
 
+def test_empty_list_parameters_have_their_list_type(planner, ros_client):
+    """
+    [] is a double (string) array over the parameter service, not a byte array nor unset.
+
+    rclpy types an empty list default as a byte array, and [] in a parameter file
+    (here None: the override it makes) leaves a parameter unset: ``ros2 param dump``
+    wrote null, and loading that dump was refused.
+    """
+    from rcl_interfaces.msg import ParameterType
+    from rclpy.parameter_client import AsyncParameterClient
+    node = planner(workspace_bounds=None)
+    remote = AsyncParameterClient(ros_client.node, node.name('planner_node'))
+    assert remote.wait_for_services(timeout_sec=20)
+    future = remote.get_parameters(['workspace_bounds', 'obstacle_radius', 'robot_names'])
+    assert ros_client.spin_until(future.done, 20)
+    assert [value.type for value in future.result().values] == [
+        ParameterType.PARAMETER_DOUBLE_ARRAY, ParameterType.PARAMETER_DOUBLE_ARRAY,
+        ParameterType.PARAMETER_STRING_ARRAY]
+
+
 def test_settings_the_obstacles_parameter_cannot_take_are_refused(planner, ros_client):
     """
     Radii, walls or obstacles the parameter's set cannot be planned with: refused on set.

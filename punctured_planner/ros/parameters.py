@@ -44,6 +44,8 @@ _KINDS = {
     'string_array': ParameterType.PARAMETER_STRING_ARRAY,
     'double_array': ParameterType.PARAMETER_DOUBLE_ARRAY,
 }
+# The list kinds, by rclpy's Parameter.Type names (an empty list alone it types a byte array).
+_LIST_TYPES = {'string_array': 'STRING_ARRAY', 'double_array': 'DOUBLE_ARRAY'}
 # Names usable as the first token of '<name>/plan', '<name>/odom' and '<name>/cmd_vel'.
 _NAME = re.compile(r'^[A-Za-z_][A-Za-z0-9_]*(/[A-Za-z_][A-Za-z0-9_]*)*$')
 
@@ -327,11 +329,28 @@ class NodeParameters(Generic[S]):
         self._check = check
         for spec in table.specs:
             node.declare_parameter(spec.name, spec.default, spec.descriptor())
+        self._type_empty_lists()
         self.settings: S = table.settings(self.values())
         if check is not None:
             check(self.settings, set(table.by_name))
         node.add_on_set_parameters_callback(self._on_set)
         node.add_post_set_parameters_callback(self._after_set)
+
+    def _type_empty_lists(self) -> None:
+        """
+        Give every empty list parameter its list type (not read-only ones: rclpy keeps those).
+
+        rclpy types an empty list default as a byte array, and ``[]`` in a parameter
+        file leaves the parameter not set: ``ros2 param get`` said so, ``ros2 param
+        dump`` wrote null, and loading that dump was refused.
+        """
+        from rclpy.parameter import Parameter  # the node's: rclpy is loaded
+        empty = [Parameter(spec.name, Parameter.Type[_LIST_TYPES[spec.kind]], [])
+                 for spec in self._table.specs
+                 if spec.kind in _LIST_TYPES and not spec.read_only
+                 and not self._node.get_parameter(spec.name).value]
+        if empty:
+            self._node.set_parameters(empty)
 
     def values(self, change: Iterable[Any] = ()) -> dict:
         """Return the node's parameter values, with a proposed change (rclpy Parameters)."""
