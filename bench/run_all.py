@@ -2,8 +2,9 @@
 Run every benchmark, print the tables, write bench/results.md and bench/results.png.
 
 ``make bench`` runs this after installing bench/requirements.txt into .venv:
-``.venv/bin/python bench/run_all.py [--quick]``. All figures come from this
-one run on the same seeded queries; the tables quote ratios, not seconds.
+``.venv/bin/python bench/run_all.py [--quick] [--output FOLDER]``. All figures come
+from this one run on the same seeded queries; the tables quote ratios, not seconds.
+A smoke run (--quick) writes into a new temporary folder unless --output says where.
 """
 
 import argparse
@@ -13,6 +14,7 @@ import os
 import platform
 import subprocess
 import sys
+import tempfile
 import time
 
 import core_speed
@@ -24,8 +26,8 @@ import peers
 import refinement
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-RESULTS_MD = os.path.join(HERE, 'results.md')
-RESULTS_PNG = os.path.join(HERE, 'results.png')
+RESULTS_MD = 'results.md'
+RESULTS_PNG = 'results.png'
 
 
 def machine():
@@ -125,9 +127,9 @@ def service_sweep(quick):
     return result.stdout.strip() or 'failed:\n' + result.stderr.strip()[-2000:]
 
 
-def write_markdown(figures, outcomes, settings, seconds, stages, profiles, service, disc_lines,
-                   refinement_lines, hall_lines):
-    """Write bench/results.md."""
+def write_markdown(folder, figures, outcomes, settings, seconds, stages, profiles, service,
+                   disc_lines, refinement_lines, hall_lines):
+    """Write results.md into folder."""
     by = {
         'k': lambda q: q.k, 'kind': lambda q: q.kind, 'd': lambda q: q.d,
         'r': lambda q: q.r, 'n': lambda q: q.n,
@@ -173,12 +175,12 @@ def write_markdown(figures, outcomes, settings, seconds, stages, profiles, servi
               'building and (de)serialising the Path messages, not planning:', '',
               '```', service, '```', '']
     parts += ['![planning time against k](results.png)', '']
-    with open(RESULTS_MD, 'w') as out:
+    with open(os.path.join(folder, RESULTS_MD), 'w') as out:
         out.write('\n'.join(parts))
 
 
-def write_plot(figures, outcomes):
-    """Write bench/results.png: time vs k against OMPL, and the core's scaling."""
+def write_plot(folder, figures, outcomes):
+    """Write results.png into folder: time vs k against OMPL, and the core's scaling."""
     import matplotlib
     matplotlib.use('Agg')
     from matplotlib import pyplot
@@ -218,7 +220,7 @@ def write_plot(figures, outcomes):
     right.grid(True, which='both', alpha=0.3)
     right.legend(fontsize=8)
     figure.tight_layout()
-    figure.savefig(RESULTS_PNG, dpi=110)
+    figure.savefig(os.path.join(folder, RESULTS_PNG), dpi=110)
 
 
 def main(argv=None):
@@ -226,7 +228,13 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.strip().splitlines()[0])
     parser.add_argument('--quick', action='store_true',
                         help='a small grid and short timing budgets (smoke run)')
+    parser.add_argument('--output', metavar='FOLDER',
+                        help='where results.md and results.png go (default: bench/, and '
+                        'for --quick a new temporary folder: a smoke run never replaces '
+                        'the published figures)')
     args = parser.parse_args(argv)
+    folder = args.output or (tempfile.mkdtemp(prefix='pp_bench_quick_') if args.quick
+                             else HERE)
     start = time.perf_counter()
     settings = peers.quick_settings() if args.quick else peers.Settings(peers.FULL_GRID)
 
@@ -250,9 +258,9 @@ def main(argv=None):
     print('==> service round trip over DDS', file=sys.stderr, flush=True)
     service = service_sweep(args.quick)
     seconds = time.perf_counter() - start
-    write_markdown(figures, outcomes, settings, seconds, stages, profiles, service,
+    write_markdown(folder, figures, outcomes, settings, seconds, stages, profiles, service,
                    disc_lines, refinement_lines, hall_lines)
-    write_plot(figures, outcomes)
+    write_plot(folder, figures, outcomes)
     print('\n'.join(headline(figures, outcomes)))
     print()
     print(format_table(peers.summary_rows(outcomes)))
@@ -268,7 +276,7 @@ def main(argv=None):
     print('\n'.join(hall_lines))
     print()
     print(service)
-    print(f'\nwrote {RESULTS_MD} and {RESULTS_PNG} in {seconds / 60:.1f} min')
+    print(f'\nwrote {RESULTS_MD} and {RESULTS_PNG} into {folder} in {seconds / 60:.1f} min')
     sys.stdout.flush()
     sys.stderr.flush()
     # nanobind reports OMPL's Python wrappers as leaked at interpreter exit: skip teardown.
