@@ -130,7 +130,8 @@ bench: setup
 	$(VPY) bench/feedforward.py
 	$(VPY) bench/topology.py
 
-# A simulated fleet, the planner and the executor: plan, execute, record (about a minute).
+# A simulated fleet, the planner and the executor: plan, execute, record (about a minute;
+# two with DRIVE=differential).
 # DRIVE=differential: four TurtleBot 4-like differential robots (config/demo_differential*).
 DRIVE ?= holonomic
 DEMO_ARGS_differential = --params config/demo_differential.yaml \

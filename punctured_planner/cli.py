@@ -298,8 +298,9 @@ def make_parser(pictures: bool = True) -> argparse.ArgumentParser:
     plan.add_argument('--no-paths', action='store_true',
                       help='print only the number of paths, not the poses')
     plan.add_argument('--mcap', metavar='OUT.mcap',
-                      help="record the plan as the node publishes it (each robot's "
-                      'Path, the markers, the domain index) for Foxglove / ros2 bag')
+                      help="record the plan as the node publishes it (the Plan message, "
+                      "each robot's Path, the markers, the domain index) for Foxglove / "
+                      'ros2 bag')
     if pictures:
         from punctured_planner.render import add_render_arguments
         add_render_arguments(plan)

@@ -59,6 +59,11 @@ class ErrorCode(enum.IntEnum):
 _AXES = 'xyz'
 
 
+def counted(count: int, noun: str) -> str:
+    """Return '1 configuration', '3 configurations': count and noun, plural where it is."""
+    return '%d %s%s' % (count, noun, '' if count == 1 else 's')
+
+
 def axis_name(axis: int) -> str:
     """Return the name of coordinate axis: x, y, z, then x3, x4, ..."""
     return _AXES[axis] if axis < len(_AXES) else f'x{axis}'

@@ -66,6 +66,7 @@ from visualization_msgs.msg import MarkerArray
 
 from ..core import ErrorCode
 from ..core import PlanningError
+from ..core.errors import counted
 from ..ros import conversions
 from ..ros import publications
 from ..ros.parameters import NodeParameters
@@ -265,10 +266,11 @@ class PlannerNode(Node):
         It gets NODE_STOPPING at once, so that the stop still answers every caller
         that reached the node before it within its timeout (doc/design.md section 16).
         """
-        message = ('%s stopping: request #%d (%d configurations) reached it before the '
+        message = ('%s stopping: request #%d (%s) reached it before the '
                    'stop signal but waited more than %.0f s into the stop, so it was not '
                    'planned; send it again to a running node'
-                   % (self.get_name(), number, len(request.configurations),
+                   % (self.get_name(), number,
+                      counted(len(request.configurations), 'configuration'),
                       STOP_PLANNING_SEC))
         self.get_logger().warning('plan_sequence #%d: %s' % (number, message))
         return conversions.fill_error(response, ErrorCode.NODE_STOPPING, message)
@@ -288,8 +290,8 @@ class PlannerNode(Node):
         now_ns = self.get_clock().now().nanoseconds
         snapshot = self.snapshot()
         logger = self.get_logger()
-        logger.info('plan_sequence #%d: %d configurations%s; snapshot: %s'
-                    % (number, len(request.configurations),
+        logger.info('plan_sequence #%d: %s%s; snapshot: %s'
+                    % (number, counted(len(request.configurations), 'configuration'),
                        ' + current state' if request.use_current_state else '',
                        snapshot.describe()))
         outcome = self._handler.handle(request, response, snapshot, now_ns)

@@ -459,8 +459,8 @@ def plan_reference(msg: Plan) -> Reference:
     stamps = [a.stamps for a in arrays]
     if not stamps or stamps[0].size < 2:
         count = stamps[0].size if stamps else 0
-        raise ValueError('plan %d has %d pose%s per path, a motion at least 2'
-                         % (msg.plan_id, count, '' if count == 1 else 's'))
+        raise ValueError('plan %d has %s per path, a motion at least 2'
+                         % (msg.plan_id, core.errors.counted(count, 'pose')))
     for name, path in zip(msg.robot_names, arrays):
         if not np.array_equal(path.stamps, stamps[0]):
             raise ValueError('plan %d: the path of %s does not have the stamps of %s'
