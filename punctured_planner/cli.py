@@ -298,7 +298,7 @@ def make_parser(pictures: bool = True) -> argparse.ArgumentParser:
     plan.add_argument('--no-paths', action='store_true',
                       help='print only the number of paths, not the poses')
     plan.add_argument('--mcap', metavar='OUT.mcap',
-                      help="record the plan as the node publishes it (the Plan message, "
+                      help='record the plan as the node publishes it (the Plan message, '
                       "each robot's Path, the markers, the domain index) for Foxglove / "
                       'ros2 bag')
     if pictures:
