@@ -115,6 +115,7 @@ def _run(recorder, request_path, mcap_path, gif_path, fleet):
     from punctured_planner_interfaces.srv import PlanSequence
     from rclpy.action import ActionClient
 
+    from .ros import conversions
     from .ros.client import call_service
     from .ros.client import FEEDBACK_SILENCE_SEC
     from .ros.client import GoalWatch
@@ -141,7 +142,7 @@ def _run(recorder, request_path, mcap_path, gif_path, fleet):
         print('demo: planning failed: %s' % (response.error_msg if response else 'no answer'),
               file=sys.stderr)
         return 1
-    planned = response.duration.sec + response.duration.nanosec * 1e-9
+    planned = conversions.duration_to_seconds(response.duration)
     print('planned plan %d: %d robots, %.2f s at %.2f m/s, min gap %.3f m, tolerance %.3f m'
           % (response.plan_id, len(response.paths), planned, request.max_speed,
              response.min_gap, response.tracking_tolerance))
@@ -157,7 +158,7 @@ def _run(recorder, request_path, mcap_path, gif_path, fleet):
               % FEEDBACK_SILENCE_SEC, file=sys.stderr)
         return 1
     recorder.spin(lambda: False, 0.3)
-    executed = result.executed_duration.sec + result.executed_duration.nanosec * 1e-9
+    executed = conversions.duration_to_seconds(result.executed_duration)
     gap = recorder.gap[-1] if recorder.gap else float('nan')
     print('executed: %s in %.2f s (plan %.2f s); true smallest gap %.4f m; largest tracking '
           'error %.3f m (tolerance %.3f m)' % (

@@ -3,7 +3,7 @@ Domains of continuity and the sequential topological complexity TC_n.
 
 The paper's algorithm has domains W_l = union of A_{j_1} x ... x A_{j_n} with
 j_1 + ... + j_n = l (Section 4): l runs over n max(r, 1) .. n (k + r), that is
-nk + 1 domains for r >= 1 and n(k - 1) + 1 for r = 0.
+nk + 1 domains for r >= 1 and n(k - 1) + 1 for r = 0 (doc/design.md section 7).
 """
 
 

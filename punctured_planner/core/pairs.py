@@ -1,7 +1,8 @@
 """
 The points of a configuration and their pairs: robots 0 .. k - 1, then obstacle j as k + j.
 
-Index arrays of point pairs are built once per size (they sit on every hot path).
+Index arrays of point pairs are built once per size (they sit on every hot path): the
+certificate's (doc/design.md section 9), the refinement's and the executor's gaps.
 """
 
 from dataclasses import dataclass

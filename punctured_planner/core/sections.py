@@ -4,7 +4,8 @@ The section Gamma on axis configurations and the sequential composition (Remark 
 Gamma(L, L') (paper, equation (3.1)): robot with paper index i lifts to height
 i along e2, slides to L'_i + i e2, and drops; a third of the time each. The
 n-th sequential section concatenates Gamma(L_m, L_{m+1}) and, by Remark 2.3,
-wraps each segment in the deformations H(C_m) forward and H(C_{m+1}) backward.
+wraps each segment in the deformations H(C_m) forward and H(C_{m+1}) backward
+(doc/design.md section 3).
 """
 
 from dataclasses import dataclass

@@ -2,7 +2,8 @@
 The strata A_i = {C : cp(C) = i} and the desingularisation scale eps(C) (paper, Section 3).
 
 All k + r points count, obstacles included: cp(C) is the number of distinct
-values of p over q_1..q_r, x_1..x_k, so r <= cp(C) <= k + r (at least 1 when r = 0).
+values of p over q_1..q_r, x_1..x_k, so r <= cp(C) <= k + r (at least 1 when r = 0;
+doc/design.md section 2).
 """
 
 import numpy as np

@@ -314,8 +314,8 @@ class PlannerNode(Node):
                         '%.6g, %.3f ms' % (number, p.positions.shape[1],
                                            len(p.waypoint_indices), p.domain_index,
                                            p.domain_count, p.min_clearance,
-                                           response.planning_time.nanosec * 1e-6
-                                           + response.planning_time.sec * 1e3))
+                                           1e3 * conversions.duration_to_seconds(
+                                               response.planning_time)))
         elif outcome.exception is not None:
             logger.error('plan_sequence #%d: %s' % (number, response.error_msg))
             logger.error(''.join(traceback.format_exception(outcome.exception)))

@@ -203,6 +203,11 @@ def duration_from_seconds(seconds: float) -> Duration:
     return duration
 
 
+def duration_to_seconds(duration: Duration) -> float:
+    """Return a builtin_interfaces/Duration as seconds (from its integer nanoseconds)."""
+    return (int(duration.sec) * 1000000000 + int(duration.nanosec)) * 1e-9
+
+
 # ---------------------------------------------------------------- arrays -> messages
 
 def robot_names(configured_names: Iterable[str], robot_count: int) -> list[str]:

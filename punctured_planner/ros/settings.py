@@ -6,8 +6,9 @@ specs (:meth:`punctured_planner.ros.parameters.Spec.field`: the default is
 the field's), read back by a :class:`~punctured_planner.ros.parameters.Table`
 with the node's cross-parameter checks. msg_docs/parameters.md,
 msg_docs/plan_executor.md and msg_docs/fleet_sim.md show these tables row for
-row. No rclpy here: ``punctured-planner plan`` reads a parameter file into
-the planner's settings offline.
+row. No rclpy here (only the rcl_interfaces messages of the descriptors):
+``punctured-planner plan`` reads a parameter file into the planner's settings
+offline.
 """
 
 from dataclasses import dataclass
