@@ -446,20 +446,25 @@ def test_plan_message_round_trip_to_the_executor_reference():
         conversions.plan_reference(message)
 
 
-@pytest.mark.parametrize('fault, words', [
-    ('paths', 'plan 3 has 4 robot_names and 3 paths'),
-    ('name', "plan 3: robot_names: '1bad' is not a valid relative ROS name"),
-    ('twice', 'plan 3: robot_names must be unique'),
-    ('nan', 'plan 3: the path of robot_2 has a non-finite pose (pose 1)'),
-    ('back', 'plan 3: its stamps do not increase at pose 3'),
-    ('radii', 'plan 3 has 2 obstacle_radii for 3 obstacles'),
-    ('one pose', 'plan 3 has 1 pose per path, a motion at least 2'),
-    ('tolerance', 'plan 3: tracking_tolerance inf is more than min_gap / 2'),
-    ('acceleration', 'plan 3: max_acceleration is inf, not a finite number >= 0'),
+@pytest.mark.parametrize('fault, words, culprits', [
+    ('paths', 'plan 3 has 4 robot_names and 3 paths', ('paths', None, None)),
+    ('name', "plan 3: robot_names: '1bad' is not a valid relative ROS name",
+     ('robot_names', None, None)),
+    ('twice', 'plan 3: robot_names must be unique', ('robot_names', None, None)),
+    ('nan', 'plan 3: the path of robot_2 has a non-finite pose (pose 1)',
+     ('paths', 'robot_2', 1)),
+    ('back', 'plan 3: its stamps do not increase at pose 3', ('paths', None, 3)),
+    ('radii', 'plan 3 has 2 obstacle_radii for 3 obstacles', ('obstacle_radii', None, None)),
+    ('one pose', 'plan 3 has 1 pose per path, a motion at least 2', ('paths', None, None)),
+    ('tolerance', 'plan 3: tracking_tolerance inf is more than min_gap / 2',
+     ('tracking_tolerance', None, None)),
+    ('acceleration', 'plan 3: max_acceleration is inf, not a finite number >= 0',
+     ('max_acceleration', None, None)),
 ])
-def test_a_plan_message_that_is_not_a_plan_is_refused_naming_the_fault(fault, words):
+def test_a_plan_message_that_is_not_a_plan_is_refused_naming_the_fault(fault, words,
+                                                                       culprits):
     """
-    The executor's intake refuses it (ValueError): never a crash or a goal that runs wild.
+    The executor's intake refuses it (InvalidPlan, culprits as data): no crash, no wild goal.
 
     Before, a name that is no ROS name crashed plan_executor when it subscribed to the
     robot's odometry, a NaN pose made a goal command NaN velocities forever, stamps going
@@ -469,9 +474,12 @@ def test_a_plan_message_that_is_not_a_plan_is_refused_naming_the_fault(fault, wo
     """
     from planner_helpers import faulty_plan
     from punctured_planner.ros import conversions
-    with pytest.raises(ValueError) as refused:
+    from punctured_planner.ros.goals import InvalidPlan
+    with pytest.raises(InvalidPlan) as refused:
         conversions.known_plan(faulty_plan(fault))
     assert words in str(refused.value), str(refused.value)
+    error = refused.value
+    assert (error.plan_id, error.field, error.robot, error.pose) == (3, *culprits)
 
 
 def test_a_goal_for_an_ignored_plan_gets_the_reason_never_an_older_plan():

@@ -73,6 +73,7 @@ from ..execution.execution import leaving_their_plane
 from ..ros import conversions
 from ..ros.goals import fleet_state
 from ..ros.goals import FleetState
+from ..ros.goals import InvalidPlan
 from ..ros.goals import KnownPlan
 from ..ros.goals import Lookup
 from ..ros.goals import PlanStore
@@ -184,7 +185,7 @@ class PlanExecutor(Node):
         """
         try:
             plan = conversions.known_plan(msg)
-        except ValueError as error:
+        except InvalidPlan as error:
             self.get_logger().error('plan %d ignored: %s' % (msg.plan_id, error))
             self._plans.ignore(msg.plan_id, str(error))
             self._wake_waits(msg.plan_id)

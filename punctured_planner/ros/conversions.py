@@ -57,6 +57,7 @@ from std_msgs.msg import UInt32
 
 from .cdr import Paths
 from .cdr import PathValues
+from .goals import InvalidPlan
 from .goals import KnownPlan
 from .parameters import ros_names
 from .settings import PlannerSettings
@@ -449,35 +450,40 @@ def plan_reference(msg: Plan) -> Reference:
     """
     Return the execution.Reference of a Plan message (seconds from its first stamp).
 
-    Raises ValueError, naming the plan and the robot, unless the message is a
+    Raises InvalidPlan, naming the plan and the robot, unless the message is a
     plan: one path per robot, the robots' names unique ROS names (each names
     its topics), every pose (position and orientation) finite, one clock (the
     same stamps on every path, at least two, strictly increasing) and numbers
     a plan can have (plan_numbers).
     """
+    plan_id = int(msg.plan_id)
     plan_numbers(msg)
     if len(msg.robot_names) != len(msg.paths):
-        raise ValueError('plan %d has %d robot_names and %d paths, one per robot'
-                         % (msg.plan_id, len(msg.robot_names), len(msg.paths)))
-    ros_names('plan %d: robot_names' % msg.plan_id, tuple(msg.robot_names))
+        raise InvalidPlan(plan_id, 'paths', ' has %d robot_names and %d paths, one per robot'
+                          % (len(msg.robot_names), len(msg.paths)))
+    try:
+        ros_names('plan %d: robot_names' % plan_id, tuple(msg.robot_names))
+    except ValueError as error:  # worded 'plan <id>: robot_names ...' already
+        raise InvalidPlan(plan_id, 'robot_names',
+                          str(error)[len('plan %d' % plan_id):]) from None
     arrays = [path_arrays(path) for path in msg.paths]
     stamps = [a.stamps for a in arrays]
     if not stamps or stamps[0].size < 2:
         count = stamps[0].size if stamps else 0
-        raise ValueError('plan %d has %s per path, a motion at least 2'
-                         % (msg.plan_id, core.errors.counted(count, 'pose')))
+        raise InvalidPlan(plan_id, 'paths', ' has %s per path, a motion at least 2'
+                          % core.errors.counted(count, 'pose'))
     for name, path in zip(msg.robot_names, arrays):
         if not np.array_equal(path.stamps, stamps[0]):
-            raise ValueError('plan %d: the path of %s does not have the stamps of %s'
-                             % (msg.plan_id, name, msg.robot_names[0]))
+            raise InvalidPlan(plan_id, 'paths', ': the path of %s does not have the stamps '
+                              'of %s' % (name, msg.robot_names[0]), robot=name)
         bad = first_non_finite(np.hstack([path.positions, path.orientations]))
         if bad is not None:
-            raise ValueError('plan %d: the path of %s has a non-finite pose (pose %d)'
-                             % (msg.plan_id, name, bad[0]))
+            raise InvalidPlan(plan_id, 'paths', ': the path of %s has a non-finite pose '
+                              '(pose %d)' % (name, bad[0]), robot=name, pose=bad[0])
     back = np.flatnonzero(np.diff(stamps[0]) <= 0)
     if back.size:
-        raise ValueError('plan %d: its stamps do not increase at pose %d of %d'
-                         % (msg.plan_id, back[0] + 1, stamps[0].size))
+        raise InvalidPlan(plan_id, 'paths', ': its stamps do not increase at pose %d of %d'
+                          % (back[0] + 1, stamps[0].size), pose=int(back[0] + 1))
     seconds = (stamps[0] - stamps[0][0]) * 1e-9
     positions = np.stack([a.positions for a in arrays], axis=1)
     orientations = normalized_quaternions(np.stack([a.orientations for a in arrays], axis=1))
@@ -487,7 +493,7 @@ def plan_reference(msg: Plan) -> Reference:
 
 def plan_numbers(msg: Plan) -> None:
     """
-    Raise ValueError, naming the field, unless a Plan's numbers are ones a plan has.
+    Raise InvalidPlan, naming the field, unless a Plan's numbers are ones a plan has.
 
     max_speed finite and > 0, max_acceleration and robot_radius finite and >= 0,
     min_gap a number, and tracking_tolerance at most min_gap / 2 (a larger one
@@ -500,31 +506,33 @@ def plan_numbers(msg: Plan) -> None:
                                      ('max_acceleration', acceleration, 0.0, False),
                                      ('robot_radius', radius, 0.0, False)):
         if not (np.isfinite(value) and (value > low if strict else value >= low)):
-            raise ValueError('plan %d: %s is %r, not a finite number %s 0'
-                             % (msg.plan_id, name, value, '>' if strict else '>='))
+            raise InvalidPlan(int(msg.plan_id), name, ': %s is %r, not a finite number %s 0'
+                              % (name, value, '>' if strict else '>='))
     if np.isnan(gap):
-        raise ValueError('plan %d: min_gap is not a number' % msg.plan_id)
+        raise InvalidPlan(int(msg.plan_id), 'min_gap', ': min_gap is not a number')
     if not tolerance <= 0.5 * gap:
-        raise ValueError('plan %d: tracking_tolerance %r is more than min_gap / 2 (min_gap %r)'
-                         % (msg.plan_id, tolerance, gap))
+        raise InvalidPlan(int(msg.plan_id), 'tracking_tolerance',
+                          ': tracking_tolerance %r is more than min_gap / 2 (min_gap %r)'
+                          % (tolerance, gap))
 
 
 def plan_bodies(msg: Plan) -> Bodies:
     """
     Return the execution.Bodies of a Plan message (robot radius, obstacles and radii).
 
-    Raises ValueError unless there is one radius per obstacle.
+    Raises InvalidPlan unless there is one radius per obstacle.
     """
     obstacles = np.array([(p.x, p.y, p.z) for p in msg.obstacles], dtype=float).reshape(-1, 3)
     radii = np.asarray(msg.obstacle_radii, dtype=float).reshape(-1)
     if radii.size != len(obstacles):
-        raise ValueError('plan %d has %d obstacle_radii for %d obstacles, one per obstacle'
-                         % (msg.plan_id, radii.size, len(obstacles)))
+        raise InvalidPlan(int(msg.plan_id), 'obstacle_radii',
+                          ' has %d obstacle_radii for %d obstacles, one per obstacle'
+                          % (radii.size, len(obstacles)))
     return Bodies(float(msg.robot_radius), obstacles, radii)
 
 
 def known_plan(msg: Plan) -> KnownPlan:
-    """Return the KnownPlan of a Plan message; raise ValueError for a plan without one clock."""
+    """Return the KnownPlan of a Plan message; raise InvalidPlan for a message that is none."""
     reference = plan_reference(msg)
     return KnownPlan(int(msg.plan_id), tuple(msg.robot_names), msg.paths[0].header.frame_id,
                      reference, plan_bodies(msg), float(msg.min_gap),

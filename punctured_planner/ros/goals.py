@@ -23,6 +23,25 @@ Result = ExecutePlan.Result
 PLAN_HISTORY = 16
 
 
+class InvalidPlan(ValueError):
+    """
+    A Plan message that is no plan, with its culprits: the plan id and the field at fault.
+
+    field is the Plan message's field ('paths', 'robot_names', 'tracking_tolerance',
+    ...), robot the robot whose path is at fault and pose the index of the pose, where
+    they are; the message says why, naming them.
+    """
+
+    def __init__(self, plan_id: int, field: str, reason: str, robot: str | None = None,
+                 pose: int | None = None) -> None:
+        """Keep the culprits; the message is 'plan <id>' and the reason."""
+        self.plan_id = plan_id
+        self.field = field
+        self.robot = robot
+        self.pose = pose
+        super().__init__('plan %d%s' % (plan_id, reason))
+
+
 @dataclass(frozen=True)
 class KnownPlan:
     """A plan heard on ``plan``, ready to execute."""
