@@ -100,6 +100,20 @@ def test_parameter_files(tmp_path):
         load_parameter_file(str(path), PLANNER)
 
 
+def test_a_nodes_parameter_files_are_checked_together(tmp_path):
+    """One of several files may be other nodes' alone; none of them the node's is refused."""
+    own, others = tmp_path / 'own.yaml', tmp_path / 'others.yaml'
+    own.write_text('/**/planner_node:\n  ros__parameters: {max_speed: 2.0}\n')
+    others.write_text('/**/plan_executor:\n  ros__parameters: {gain: 1.0}\n')
+    PLANNER.check_files(['planner_node', '--ros-args', '--params-file', str(own),
+                         '--params-file', str(others)])
+    with pytest.raises(ValueError, match='no section applies to planner_node'):
+        PLANNER.check_files(['--ros-args', '--params-file', str(others)])
+    # renamed, its sections carry the new name: not checked
+    PLANNER.check_files(['--ros-args', '-r', '__node:=fleet_planner',
+                         '--params-file', str(others)])
+
+
 @pytest.mark.parametrize('table, values, words', [
     (EXECUTOR, {'mode': 'torque'}, 'mode must be one of velocity, reference'),
     (EXECUTOR, {'shared_clock': 'yes'}, 'shared_clock'),
@@ -112,7 +126,7 @@ def test_parameter_files(tmp_path):
                  'speed_factors': [11.0]}, r'outside \[0, 10\]'),
     (FLEET_SIM, {'robot_names': ['a'], 'initial_positions': [0.0] * 3,
                  'latencies': [0.1, 0.2]}, '2 values for 1 robots'),
-    (FLEET_SIM, {'obstacles': [0.0] * 6, 'obstacle_radius': [1.0] * 3}, 'one each'),
+    (FLEET_SIM, {'obstacles': [0.0] * 6, 'obstacle_radius': [1.0] * 3}, 'one per obstacle'),
     (FLEET_SIM, {'frame_id': ''}, 'frame_id must not be empty'),
     (EXECUTOR, {'drive': ['tank']}, r"drive\[0\] = 'tank' is not one of holonomic"),
     (EXECUTOR, {'drive': []}, 'one value or one per robot'),

@@ -31,6 +31,7 @@ and one control step inside the tolerance would stop it centimetres beyond.
 """
 
 from collections import deque
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -95,22 +96,32 @@ class ExecutionSettings:
                 per_robot('max_accelerations', self.max_accelerations, robot_count))
 
 
-def per_robot(name: str, values: tuple, robot_count: int) -> np.ndarray | None:
-    """Return values (one, or one per robot) as (k,), None for none; ValueError if not k."""
-    if not values:
+def one_or_each(name: str, values: Sequence, count: int,
+                items: str = 'robots') -> np.ndarray | None:
+    """
+    Return values, one for all or one per item, as a (count,) array; None for none.
+
+    The rule of every parameter that gives one value for all robots (obstacles) or
+    one each; ValueError naming the parameter for any other count.
+    """
+    if not len(values):
         return None
-    if len(values) not in (1, robot_count):
-        raise ValueError('%s has %d values for %d robots (one, or one per robot)'
-                         % (name, len(values), robot_count))
-    return np.broadcast_to(np.asarray(values, dtype=float), robot_count).copy()
+    if len(values) not in (1, count):
+        raise ValueError('%s has %d values for %d %s (one, or one per %s)'
+                         % (name, len(values), count, items, items[:-1]))
+    return np.broadcast_to(np.asarray(values), count).copy()
+
+
+def per_robot(name: str, values: tuple, robot_count: int) -> np.ndarray | None:
+    """Return values (one, or one per robot) as (k,) numbers, None for none (one_or_each)."""
+    each = one_or_each(name, values, robot_count)
+    return None if each is None else each.astype(float)
 
 
 def differential_mask(drive: tuple, robot_count: int) -> np.ndarray:
     """Return the (k,) mask of drive's differential robots (one value, or one per robot)."""
-    if len(drive) not in (1, robot_count):
-        raise ValueError('drive has %d values for %d robots (one, or one per robot)'
-                         % (len(drive), robot_count))
-    return np.broadcast_to(np.asarray(drive) == DIFFERENTIAL, robot_count).copy()
+    each = one_or_each('drive', drive, robot_count)
+    return np.zeros(robot_count, dtype=bool) if each is None else each == DIFFERENTIAL
 
 
 def leaving_their_plane(differential: np.ndarray, reference: Reference) -> np.ndarray:

@@ -260,31 +260,35 @@ class Table(Generic[S]):
         Raise ValueError for a --params-file of a node's command line the node cannot use.
 
         rcl refuses a file it cannot parse, with a traceback; a node starts on its
-        defaults from a file none of whose sections applies to it, and ignores a
-        misspelt name in its own section (robot_radiuss). All are refused here with
-        the reason, as ``punctured-planner plan --params`` refuses them
-        (load_parameter_file). The values are the node's to check when it declares
-        them. A command line that renames the node (__node:=) is not checked: its
-        sections carry the new name.
+        defaults from files none of whose sections applies to it (a misspelt section
+        name), and ignores a misspelt name in its own section (robot_radiuss). All are
+        refused here with the reason, as ``punctured-planner plan --params`` refuses
+        them (load_parameter_file); one file of several may be other nodes' alone.
+        The values are the node's to check when it declares them. A command line that
+        renames the node (__node:=) is not checked: its sections carry the new name.
         """
         arguments = list(arguments)
         if any(argument.startswith(('__node:=', '__name:=')) for argument in arguments):
             return
         paths = [arguments[i + 1] for i, argument in enumerate(arguments[:-1])
                  if argument == '--params-file']
+        applies = not paths
         for path in paths:
             try:
-                values = load_parameter_file(path, self)
+                read = read_parameter_file(path, self)
             except OSError as error:
                 raise ValueError('--params-file %s: %s' % (path, error.strerror)) from None
             except yaml.YAMLError as error:
                 raise ValueError('--params-file %s: not YAML: %s' % (
                     path, ' '.join(str(error).split()))) from None
-            unknown = sorted(set(values) - set(self.by_name))
+            applies = applies or read.applies
+            unknown = sorted(set(read.values) - set(self.by_name))
             if unknown:
                 raise ValueError('%s: unknown parameter %r of %s (parameters: %s)'
                                  % (path, unknown[0], self.node_name,
                                     ', '.join(self.by_name)))
+        if not applies:
+            raise ValueError('--params-file %s: %s' % (', '.join(paths), _no_section(self)))
 
     def settings(self, values: dict) -> S:
         """
@@ -391,7 +395,33 @@ class NodeParameters(Generic[S]):
 RCLPY_PARAMETERS = ('use_sim_time', 'start_type_description_service')
 
 
+@dataclass(frozen=True)
+class FileValues:
+    """One node's values from a parameter file, and whether any section of it applies."""
+
+    values: dict
+    applies: bool
+
+
 def load_parameter_file(path: str, table: Table) -> dict:
+    """
+    Return one node's parameter values from a ROS 2 parameter YAML file.
+
+    As read_parameter_file; raises ValueError for a file none of whose sections
+    applies to the node, too.
+    """
+    read = read_parameter_file(path, table)
+    if not read.applies:
+        raise ValueError('%s: %s' % (path, _no_section(table)))
+    return read.values
+
+
+def _no_section(table: Table) -> str:
+    """Return the reason a file is not the node's: no section names it."""
+    return 'no section applies to %s (/** or %s)' % (table.node_name, table.node_name)
+
+
+def read_parameter_file(path: str, table: Table) -> FileValues:
     """
     Return one node's parameter values from a ROS 2 parameter YAML file.
 
@@ -400,8 +430,7 @@ def load_parameter_file(path: str, table: Table) -> dict:
     declares, a ``/**`` section gives only the table's parameters (the others are
     other nodes'), and rclpy's own (use_sim_time) are left out; a name the node's
     own section sets and the table lacks is kept (settings() refuses it: a typo).
-    Raises ValueError for a file that is not a ROS parameter file, or none of
-    whose sections applies to the node.
+    Raises ValueError for a file that is not a ROS parameter file.
     """
     with open(path, encoding='utf-8') as stream:
         data = yaml.safe_load(stream) or {}
@@ -424,7 +453,4 @@ def load_parameter_file(path: str, table: Table) -> dict:
         values.update((name, value) for name, value in parameters.items()
                       if name not in RCLPY_PARAMETERS
                       and (name in table.by_name or not shared))
-    if data and not applied:
-        raise ValueError('%s: no section applies to %s (sections: %s; /** or %s)'
-                         % (path, table.node_name, ', '.join(map(str, data)), table.node_name))
-    return values
+    return FileValues(values, applied or not data)

@@ -33,6 +33,7 @@ from ..execution import Bodies
 from ..execution import DRIVES
 from ..execution import ExecutionSettings
 from ..execution.execution import differential_mask
+from ..execution.execution import one_or_each
 from ..sim import FleetSettings
 
 # The variant parameter's default: 'discs' with a robot radius, else 'spread'.
@@ -393,9 +394,12 @@ class FleetSimSettings:
     def fleet(self) -> FleetSettings:
         """Return the fleet's physics: bodies, speed limit and factors, latencies, noise."""
         obstacles = np.asarray(self.obstacles, dtype=float).reshape(-1, 3)
-        radii = np.asarray(self.obstacle_radius, dtype=float)
+        radii = one_or_each('obstacle_radius', self.obstacle_radius, len(obstacles),
+                            'obstacles')
         bodies = Bodies(self.robot_radius, obstacles,
-                        np.broadcast_to(radii if radii.size else 0.0, len(obstacles)).copy())
+                        np.zeros(len(obstacles)) if radii is None else radii.astype(float))
+        accelerations = one_or_each('max_acceleration', self.max_acceleration,
+                                    len(self.robot_names))
         return FleetSettings(
             bodies=bodies, speed_limit=self.speed_limit,
             speed_factors=np.asarray(self.speed_factors) if self.speed_factors else None,
@@ -403,8 +407,8 @@ class FleetSimSettings:
             velocity_noise=self.velocity_noise, command_timeout=self.command_timeout,
             seed=self.seed, differential=differential_mask(self.drive, len(self.robot_names)),
             yaw_rate_limit=self.yaw_rate_limit,
-            max_acceleration=np.broadcast_to(self.max_acceleration or 0.0,
-                                             len(self.robot_names)).copy(),
+            max_acceleration=(np.zeros(len(self.robot_names)) if accelerations is None
+                              else accelerations.astype(float)),
             max_yaw_acceleration=self.max_yaw_acceleration)
 
 
@@ -419,16 +423,12 @@ def _fleet_counts(settings: FleetSimSettings) -> None:
         if values and len(values) != count:
             raise ValueError('%s has %d values for %d robots' % (name, len(values), count))
     differential_mask(settings.drive, count)
-    if len(settings.max_acceleration) not in (0, 1, count):
-        raise ValueError('max_acceleration has %d values for %d robots (0, 1 or one each)'
-                         % (len(settings.max_acceleration), count))
+    one_or_each('max_acceleration', settings.max_acceleration, count)
     unknown = [name for name in settings.muted_robots if name not in settings.robot_names]
     if unknown:
         raise ValueError('muted_robots names %s, not among robot_names' % ', '.join(unknown))
-    obstacles = len(settings.obstacles) // 3
-    if len(settings.obstacle_radius) not in (0, 1, obstacles):
-        raise ValueError('obstacle_radius has %d values for %d obstacles (0, 1 or one each)'
-                         % (len(settings.obstacle_radius), obstacles))
+    one_or_each('obstacle_radius', settings.obstacle_radius, len(settings.obstacles) // 3,
+                'obstacles')
 
 
 FLEET_SIM = Table('fleet_sim', FleetSimSettings, checks=(_fleet_counts,))
