@@ -717,3 +717,43 @@ def test_a_robot_ahead_of_its_reference_does_not_hold_the_clock():
     step = sideways.step(0.05, reference.position(sideways.plan_time) + [[0.1, 0.35, 0]],
                          [False])
     assert step.rate == 0.0, 'its sideways error counts, ahead or not'
+
+
+def test_one_hold_whatever_holds_the_clock_ends_after_its_timeout():
+    """
+    ClockHold: stale odometry and a clock held for errors are one hold, never reset by flaps.
+
+    A robot whose odometry flapped (stale, fresh with the clock still held, stale) holds
+    one hold that ends after the timeout, naming it stale; the clock moving with fresh
+    odometry ends a hold; a goal's first step (dt 0) starts none.
+    """
+    from punctured_planner.execution.hold import ClockHold
+    hold = ClockHold()
+    assert hold.update(0.0, (), 0.0, 0.0, 1.0) is None and hold.since is None
+    steps = [(0.0, ('r1',)), (0.0, ()), (0.0, ('r1',)), (0.0, ())] * 3
+    over = None
+    for i, (rate, stale) in enumerate(steps):
+        over = hold.update(rate, stale, 0.1 * (i + 1), 0.1, 1.0)
+        if over is not None:
+            break
+    assert over is not None and over.stale == ('r1',) and over.seconds == pytest.approx(1.0)
+    moving = ClockHold()
+    for i in range(30):
+        assert moving.update(0.0 if i % 2 else 1.0, (), 0.1 * i, 0.1, 1.0) is None
+    held = ClockHold()
+    results = [held.update(0.0, (), 0.1 * i, 0.1, 1.0) for i in range(12)]
+    assert results[-1] is not None and results[-1].stale == ()
+
+
+def test_a_goal_starts_only_at_the_plans_start_and_a_hold_names_who_it_waits_for():
+    """off_start: the robots beyond the tolerance, and how far; waited_for: who holds it."""
+    from punctured_planner.execution.hold import off_start, waited_for
+    reference, _, gap = certified_fleet()
+    delta = tracking_tolerance(gap, np.inf)
+    positions = reference.position(0.0).copy()
+    assert off_start(reference, positions, delta).robots.size == 0
+    positions[2] += [0.0, 2 * delta, 0.0]
+    far = off_start(reference, positions, delta)
+    assert far.robots.tolist() == [2] and far.distances[0] == pytest.approx(2 * delta)
+    assert waited_for(np.array([0.1, 0.5, 0.7]), 0.5).tolist() == [1, 2]
+    assert waited_for(np.array([0.1, 0.3, 0.2]), 0.5).tolist() == [1]

@@ -52,7 +52,6 @@ from typing import Any
 from geometry_msgs.msg import PoseStamped
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
-import numpy as np
 from punctured_planner_interfaces.action import ExecutePlan
 from punctured_planner_interfaces.msg import Plan
 from rclpy.action import ActionServer
@@ -70,6 +69,9 @@ from ..execution import Execution
 from ..execution import Step
 from ..execution.execution import differential_mask
 from ..execution.execution import leaving_their_plane
+from ..execution.hold import ClockHold
+from ..execution.hold import off_start
+from ..execution.hold import waited_for
 from ..ros import conversions
 from ..ros.goals import fleet_state
 from ..ros.goals import FleetState
@@ -106,8 +108,7 @@ class Run:
     started_ns: int = 0
     last_ns: int = 0
     stale: tuple = ()
-    held_since: int | None = None  # ns: the first control step of the current hold
-    stale_in_hold: tuple = ()  # the robots whose odometry went stale during that hold
+    hold: ClockHold = field(default_factory=ClockHold)  # the plan clock's current hold
 
 
 @dataclass(eq=False)
@@ -435,15 +436,15 @@ class PlanExecutor(Node):
                                               ', '.join(self.resolve_topic_name(n + '/odom')
                                                         for n in state.stale)))
             return None
-        away = np.linalg.norm(state.positions - plan.reference.position(0.0), axis=1)
-        far = np.flatnonzero(away > plan.tolerance)
-        if far.size:
+        far = off_start(plan.reference, state.positions, plan.tolerance)
+        if far.robots.size:
             self._finish(run, Result.NOT_AT_START, '%s farther than the tracking tolerance '
                          '%.6g m from the start of plan %d (%s): the plan is certified from '
                          'its start only; plan again from where they are (use_current_state)'
-                         % ('robot' if far.size == 1 else 'robots', plan.tolerance,
-                            plan.plan_id, ', '.join('%s %.3f m' % (plan.names[i], away[i])
-                                                    for i in far)))
+                         % ('robot' if far.robots.size == 1 else 'robots', plan.tolerance,
+                            plan.plan_id, ', '.join(
+                                '%s %.3f m' % (plan.names[i], distance)
+                                for i, distance in zip(far.robots, far.distances))))
             return None
         execution = Execution(plan.reference, plan.tolerance, settings.execution, plan.bodies)
         run.execution = execution
@@ -459,37 +460,25 @@ class PlanExecutor(Node):
         """
         End the goal once the clock held hold_timeout, every robot sent zero velocity.
 
-        One hold, whatever holds the clock (odometry stale, or a robot that does not
-        follow): ODOMETRY_LOST if some robot's odometry went stale during it, else
-        CLOCK_HELD, naming the robots the clock waits for. Two holds of their own let a
-        robot whose odometry flapped reset each the other's. The goal's first step
-        (dt = 0, its rate rising from 0) neither starts nor judges a hold.
+        One hold, whatever holds the clock (execution.hold.ClockHold):
+        ODOMETRY_LOST if some robot's odometry went stale during it, else
+        CLOCK_HELD, naming the robots the clock waits for.
         """
-        if step.rate > 0.0 and not state.stale:
-            run.held_since, run.stale_in_hold = None, ()
-            return False
-        if dt <= 0.0:
-            return False
-        if run.held_since is None:
-            run.held_since = now
-        run.stale_in_hold = tuple(dict.fromkeys(run.stale_in_hold + state.stale))
-        held = (now - run.held_since) * 1e-9
         timeout = self._settings.hold_timeout
-        if held < timeout:
+        over = run.hold.update(step.rate, state.stale, now * 1e-9, dt, timeout)
+        if over is None:
             return False
         held_at = 'the plan clock held %.3f s at plan time %.3f s, hold_timeout %g s' % (
-            held, step.plan_time, timeout)
-        if run.stale_in_hold:
+            over.seconds, step.plan_time, timeout)
+        if over.stale:
             self._end(run, Result.ODOMETRY_LOST, 'odometry of %s stale (older than %g s; '
                       'topics %s): %s; every robot was sent zero velocity'
-                      % (', '.join(run.stale_in_hold), self._settings.odom_timeout,
+                      % (', '.join(over.stale), self._settings.odom_timeout,
                          ', '.join(self.resolve_topic_name(n + '/odom')
-                                   for n in run.stale_in_hold), held_at))
+                                   for n in over.stale), held_at))
             return True
         plan, limit = run.plan, run.plan.tolerance * self._settings.execution.hold_fraction
-        waited = np.flatnonzero(step.watched >= limit)
-        if not waited.size:  # held by a turn's cap: the robot farthest behind
-            waited = np.array([int(np.argmax(step.watched))])
+        waited = waited_for(step.watched, limit)
         self._end(run, Result.CLOCK_HELD, '%s, the odometry fresh: the clock waits for %s '
                   '(hold_fraction x the tracking tolerance: %.6g m); every robot was sent '
                   'zero velocity' % (held_at, ', '.join(

@@ -1,0 +1,83 @@
+"""
+When a goal may start, and when a hold of the plan clock ends it (doc/design.md section 13).
+
+A plan is certified from its start: a goal starts only with every robot within the
+tracking tolerance of its reference there (:func:`off_start`). The plan clock holds
+for stale odometry or for a robot that does not follow; one hold, whatever holds it,
+may last ``hold_timeout`` (:class:`ClockHold`): then the goal ends, for lost odometry
+if some robot's went stale during the hold, else for the robots the clock waits for
+(:func:`waited_for`). The plan_executor node words and sends the results.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .reference import Reference
+
+
+@dataclass(frozen=True)
+class OffStart:
+    """The robots (indices) farther than the tolerance from the plan's start, and how far."""
+
+    robots: np.ndarray
+    distances: np.ndarray
+
+
+def off_start(reference: Reference, positions: np.ndarray, tolerance: float) -> OffStart:
+    """Return the robots of positions (k, 3) beyond tolerance from the reference's start."""
+    away = np.linalg.norm(positions - reference.position(0.0), axis=1)
+    far = np.flatnonzero(away > tolerance)
+    return OffStart(far, away[far])
+
+
+@dataclass(frozen=True)
+class HoldOver:
+    """A hold that lasted its timeout: seconds held, and the robots stale during it."""
+
+    seconds: float
+    stale: tuple
+
+
+@dataclass
+class ClockHold:
+    """
+    The current hold of a goal's plan clock: since when, and who went stale during it.
+
+    One hold, whatever holds the clock: two holds of their own let a robot whose
+    odometry flapped reset each the other's and hold the fleet for good.
+    """
+
+    since: float | None = None   # seconds: the first control step of the current hold
+    stale: tuple = ()            # names whose odometry went stale during it
+
+    def update(self, rate: float, stale: tuple, now: float, dt: float,
+               timeout: float) -> HoldOver | None:
+        """
+        Follow one control step (clock rate, stale names, now and dt in seconds).
+
+        Return the HoldOver once the hold lasted timeout (s), else None. The clock
+        moving with fresh odometry ends a hold; the goal's first step (dt = 0, its
+        rate rising from 0) neither starts nor judges one.
+        """
+        if rate > 0.0 and not stale:
+            self.since, self.stale = None, ()
+            return None
+        if dt <= 0.0:
+            return None
+        if self.since is None:
+            self.since = now
+        self.stale = tuple(dict.fromkeys(self.stale + tuple(stale)))
+        held = now - self.since
+        return HoldOver(held, self.stale) if held >= timeout else None
+
+
+def waited_for(watched: np.ndarray, limit: float) -> np.ndarray:
+    """
+    Return the robots (indices) the clock waits for: watched errors (k,) at least limit.
+
+    limit is hold_fraction x the tracking tolerance; a clock held by a turn's cap
+    alone waits for the robot farthest behind.
+    """
+    waited = np.flatnonzero(watched >= limit)
+    return waited if waited.size else np.array([int(np.argmax(watched))])
