@@ -202,8 +202,13 @@ def test_domains_equal_the_paper_variant_and_waypoints_are_exact(request):
 @PROPERTY
 @given(requests(max_robots=5, max_obstacles=4, max_configurations=3, modes=('float',)),
        st.sampled_from([0.0, 0.05]), st.integers(0, 2 ** 31))
+# A fresh-clone CI run found 10.3x here (one robot standing still by two pillars, the
+# other passing): the bound was 10x then, below the 100x doc/design.md section 14 holds.
+@example(request=(np.array([[0.0, -0.5], [1.5, 0.0]]),
+                  np.array([[[0.0, 0.0], [0.0, 1.0]], [[0.0, 0.0], [0.0, 1.0]],
+                            [[0.0, 0.0], [0.0, 0.125]]]), 'float'), radius=0.05, seed=0)
 def test_a_small_change_inside_a_domain_moves_the_motion_little(request, radius, seed):
-    """Continuity, measured: a 1e-6 change that keeps every cp moves the motion by <= 1e-5."""
+    """Continuity, measured: a 1e-6 change that keeps every cp moves the motion by <= 1e-4."""
     obstacles, configurations, _ = request
     d = obstacles.shape[1]
     workspace = Workspace(obstacles, dimension=d, variant='discs', robot_radius=radius,
@@ -219,7 +224,7 @@ def test_a_small_change_inside_a_domain_moves_the_motion_little(request, radius,
     assume(np.all(np.abs(configurations) < 1e3))
     tau = np.linspace(0.0, 1.0, 2001)
     change = np.abs(before.position(tau) - after.position(tau)).max()
-    assert change <= 1e-5, change
+    assert change <= 1e-4, change
 
 
 def test_gap_is_distance_minus_radii_and_required_clearance_applies_to_it():

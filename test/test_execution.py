@@ -743,6 +743,36 @@ def test_one_hold_whatever_holds_the_clock_ends_after_its_timeout():
     held = ClockHold()
     results = [held.update(0.0, (), 0.1 * i, 0.1, 1.0) for i in range(12)]
     assert results[-1] is not None and results[-1].stale == ()
+    # a clock that crawls towards 0 without reaching it is held
+    crawling = ClockHold()
+    results = [crawling.update(0.5 ** i, (), 0.1 * i, 0.1, 1.0) for i in range(20)]
+    assert results[-1] is not None and results[-1].seconds >= 1.0
+
+
+def test_a_robot_that_cannot_move_holds_the_clock_below_the_held_rate():
+    """
+    Its error tends to the hold threshold, the rate to 0: below HELD_RATE, and it stays.
+
+    So ClockHold, which counts a clock below HELD_RATE as held, ends such a goal
+    CLOCK_HELD after hold_timeout however the rate approaches 0.
+    """
+    from punctured_planner.execution.hold import HELD_RATE
+    reference, bodies, gap = certified_fleet()
+    k = reference.robot_count
+    fleet = Fleet(reference.position(0.0), FleetSettings(
+        bodies=bodies, speed_limit=0.5, speed_factors=np.where(np.arange(k) == 1, 0.0, 1.0)))
+    execution = Execution(reference, tracking_tolerance(gap, np.inf),
+                          ExecutionSettings(speed_limit=0.5), bodies)
+    rates, now = [], 0.0
+    while now < 60.0:
+        step = execution.step(0.05, fleet.positions, np.zeros(k, dtype=bool))
+        rates.append(step.rate)
+        for robot in range(k):
+            fleet.command(robot, step.velocities[robot], now)
+        fleet.step(now, 0.05)
+        now += 0.05
+    below = np.flatnonzero(np.array(rates) < HELD_RATE)
+    assert below.size and np.all(np.array(rates[below[0]:]) < HELD_RATE)
 
 
 def test_a_goal_starts_only_at_the_plans_start_and_a_hold_names_who_it_waits_for():

@@ -15,6 +15,12 @@ import numpy as np
 
 from .reference import Reference
 
+# The clock counts as held below this rate. Near the hold threshold it slows in
+# proportion to the room left, so a robot that cannot move makes the rate tend to 0
+# without reaching it: the hold flickered and a goal with a stuck robot whose
+# odometry stayed fresh ran on for good (a DDS test, 1 run in 3 under load).
+HELD_RATE = 0.05
+
 
 @dataclass(frozen=True)
 class OffStart:
@@ -57,10 +63,10 @@ class ClockHold:
         Follow one control step (clock rate, stale names, now and dt in seconds).
 
         Return the HoldOver once the hold lasted timeout (s), else None. The clock
-        moving with fresh odometry ends a hold; the goal's first step (dt = 0, its
-        rate rising from 0) neither starts nor judges one.
+        moving (at HELD_RATE at least) with fresh odometry ends a hold; the goal's
+        first step (dt = 0, its rate rising from 0) neither starts nor judges one.
         """
-        if rate > 0.0 and not stale:
+        if rate >= HELD_RATE and not stale:
             self.since, self.stale = None, ()
             return None
         if dt <= 0.0:
