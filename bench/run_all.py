@@ -235,6 +235,7 @@ def main(argv=None):
     args = parser.parse_args(argv)
     folder = args.output or (tempfile.mkdtemp(prefix='pp_bench_quick_') if args.quick
                              else HERE)
+    os.makedirs(folder, exist_ok=True)  # before the run, not after its 14 minutes
     start = time.perf_counter()
     settings = peers.quick_settings() if args.quick else peers.Settings(peers.FULL_GRID)
 

@@ -92,14 +92,14 @@ def _call(args):
     request = _request(args)
     if request is None:
         return EXIT_USAGE
-    with session(CLI_NODE) as (node, executor):
-        client = node.create_client(PlanSequence, args.service, qos_profile=CLIENT_QOS)
+    with session(CLI_NODE) as ros:
+        client = ros.node.create_client(PlanSequence, args.service, qos_profile=CLIENT_QOS)
         if not client.wait_for_service(timeout_sec=args.wait):
             print('punctured-planner: service %s not available after %.1f s'
                   % (args.service, args.wait), file=sys.stderr)
             return EXIT_NO_SERVICE
-        executor.add_node(node)
-        response = call_service(executor, client, request, args.timeout)
+        ros.executor.add_node(ros.node)
+        response = call_service(ros.executor, client, request, args.timeout)
         if response is None:
             print('punctured-planner: no response from %s within %.1f s'
                   % (args.service, args.timeout), file=sys.stderr)
@@ -149,9 +149,9 @@ def reset_obstacles(node: 'Node', executor: 'Executor', planner_node: str,
 
 def _reset(args):
     from punctured_planner.ros.client import session
-    with session(CLI_NODE) as (node, executor):
-        executor.add_node(node)
-        problem = reset_obstacles(node, executor, args.node, args.wait)
+    with session(CLI_NODE) as ros:
+        ros.executor.add_node(ros.node)
+        problem = reset_obstacles(ros.node, ros.executor, args.node, args.wait)
     if problem:
         print('punctured-planner: %s' % problem, file=sys.stderr)
         return EXIT_NO_SERVICE

@@ -204,7 +204,7 @@ def _print_ratios(recorder, executed, fleet):
     straight = np.linalg.norm(reference.positions[-1] - reference.positions[0], axis=1)
     bound = float(straight[slowest]) / speed
     retimed = float(stamps(reference.positions, plan.max_speed * factors[slowest],
-                           plan.max_acceleration, plan.min_gap)[-1])
+                           plan.max_acceleration, plan.tracking_tolerance)[-1])
     print('slowest robot %s (%.2f m/s): executed %.2f s = %.2fx its straight-line bound '
           '%.2f s, %.2fx the plan at its speed %.2f s (plan %.2f s at %.2f m/s, %.2f m/s^2: '
           'executed / plan %.2f)' % (
@@ -305,9 +305,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     from .ros.client import session
     code = 1
     try:
-        with session('demo', namespace='/demo') as (node, executor):
-            code = _run(Recorder(node, executor, names), args.request, args.mcap, args.gif,
-                        fleet)
+        with session('demo', namespace='/demo') as ros:
+            code = _run(Recorder(ros.node, ros.executor, names), args.request, args.mcap,
+                        args.gif, fleet)
     except KeyboardInterrupt:
         print('demo: interrupted')
     finally:

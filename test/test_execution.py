@@ -253,6 +253,36 @@ def test_stale_odometry_holds_the_clock_after_braking_and_the_stale_robot_follow
     unlimited.step(0.05, linear.position(0.0), [False, False])
     held = unlimited.step(0.05, linear.position(0.0), [False, True])
     assert held.rate == 0.0 and np.all(held.velocities[1] == 0.0), 'no limit: held at once'
+    # while one robot is stale, another one stuck behind still holds the clock at once
+    # (the braking took the stale robot's hold alone: a probe's 0.758 m for 0.15 m)
+    both = Execution(timed, 0.5, ExecutionSettings(speed_limit=2.0))
+    for _ in range(60):
+        step = both.step(0.05, both.reference.position(both.plan_time), [False, False])
+    stuck = both.reference.position(both.plan_time)
+    stuck[0] -= [0.4, 0.0, 0.0]
+    step = both.step(0.05, stuck, [False, True])
+    assert step.rate == 0.0 and step.allowed == 0.0
+    # without the shared clock a stale robot is not driven blind
+    alone = Execution(timed, 0.5, ExecutionSettings(speed_limit=2.0, shared_clock=False))
+    for _ in range(20):
+        step = alone.step(0.05, alone.reference.position(alone.plan_time), [False, False])
+    step = alone.step(0.05, alone.reference.position(alone.plan_time), [False, True])
+    assert np.all(step.velocities[1] == 0.0)
+
+
+def test_a_stale_robot_keeps_its_last_heading():
+    """fleet_state: a stale robot's last orientation, which its feed-forward is rotated by."""
+    from planner_helpers import faulty_plan
+    from punctured_planner.ros import conversions
+    from punctured_planner.ros.goals import fleet_state
+    from punctured_planner.ros.snapshot import RobotOdometry
+    plan = conversions.known_plan(faulty_plan('none'))
+    facing_y = np.array([0.0, 0.0, np.sqrt(0.5), np.sqrt(0.5)])
+    odometry = {name: RobotOdometry(plan.reference.position(0.0)[i], facing_y, 'map', 0, 0)
+                for i, name in enumerate(plan.names)}
+    state = fleet_state(plan, odometry, int(2e9), 0.5)
+    assert state.stale == tuple(plan.names)
+    assert np.array_equal(state.orientations, np.tile(facing_y, (len(plan.names), 1)))
 
 
 def demo_plan():

@@ -110,8 +110,12 @@ def test_a_nodes_parameter_files_are_checked_together(tmp_path):
     with pytest.raises(ValueError, match='no section applies to planner_node'):
         PLANNER.check_files(['--ros-args', '--params-file', str(others)])
     # renamed, its sections carry the new name: not checked
-    PLANNER.check_files(['--ros-args', '-r', '__node:=fleet_planner',
-                         '--params-file', str(others)])
+    for rename in ('__node:=fleet_planner', 'planner_node:__node:=fleet_planner'):
+        PLANNER.check_files(['--ros-args', '-r', rename, '--params-file', str(others)])
+    # rcl's nested form may name the node: not refused
+    nested = tmp_path / 'nested.yaml'
+    nested.write_text('fleet:\n  planner_node:\n    ros__parameters: {max_speed: 2.0}\n')
+    PLANNER.check_files(['--ros-args', '--params-file', str(nested)])
 
 
 @pytest.mark.parametrize('table, values, words', [

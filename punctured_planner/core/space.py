@@ -169,29 +169,36 @@ class Workspace:
         With bodies, a required gap c is planned for by inflating every body by
         c / 2: a gap >= 0 between the inflated bodies is a gap >= c between the real ones.
         """
-        robot_radius, obstacle_radii = self._planned_radii()
-        return DiscLayout.from_radii(self.frame, self.obstacles, robot_radius, obstacle_radii,
-                                     self.min_spacing, self.bounds)
+        inflation = self._inflation()
+        return DiscLayout.from_radii(self.frame, self.obstacles, self.robot_radius + inflation,
+                                     self.obstacle_radii + inflation, self.min_spacing,
+                                     self.bounds)
 
-    def _planned_radii(self):
-        """Return (R, rho (r,)) as planned for: inflated by half the required gap c."""
-        inflation = 0.5 * self.required_clearance if self.has_bodies else 0.0
-        return self.robot_radius + inflation, self.obstacle_radii + inflation
+    def _inflation(self) -> float:
+        """Return what every body's radius is planned with more: half the required gap c."""
+        return 0.5 * self.required_clearance if self.has_bodies else 0.0
 
     def _default_frame(self):
         """
         Return choose_frame's frame for the obstacles and walls.
 
         Oblique frames round every projection: only the discs' margins are far above
-        that. The discs stage beyond each pillar's clearance (PillarClearance), their
-        centres R inside the walls, which is the room the frame is chosen by.
+        that. With walls the discs stage beyond each pillar's clearance
+        (PillarClearance), their centres R inside the walls (R as planned, inflated by
+        required_clearance), which is the room the frame is chosen by; without walls
+        an oblique frame must save R of the climb.
         """
         if self.variant != 'discs':
             return choose_frame(self.obstacles, self.bounds)
-        robot_radius, obstacle_radii = self._planned_radii()
-        clearance = PillarClearance.from_radii(robot_radius, obstacle_radii, self.min_spacing)
+        if self.bounds is None:
+            return choose_frame(self.obstacles, oblique=True, robot_radius=self.robot_radius)
+        inflation = self._inflation()
+        clearance = PillarClearance.from_radii(self.robot_radius + inflation,
+                                               self.obstacle_radii + inflation,
+                                               self.min_spacing)
         return choose_frame(self.obstacles, self.bounds, oblique=True,
-                            robot_radius=robot_radius, clearance=clearance.clear)
+                            robot_radius=self.robot_radius + inflation,
+                            clearance=clearance.clear)
 
 
 def _checked_radii(robot_radius, obstacle_radius, obstacle_count):

@@ -10,8 +10,9 @@ of disc robots and obstacles, and ``execution`` one control step: advance the
 shared clock as far as the robots' errors allow, then track the reference with
 feed-forward and saturated feedback; ``unicycle`` is the tracking law of
 differential-drive robots (a point ahead of the centre, turns in place, the
-clock's caps before corners). The ``plan_executor`` node is a thin
-adapter around :class:`Execution`; the simulated fleet (``sim``) uses
+clock's caps before corners), ``hold`` when a goal may start and when a hold
+of the clock ends it. The ``plan_executor`` node is a thin adapter around
+:class:`Execution` and ``hold``; the simulated fleet (``sim``) uses
 ``bodies`` for its true gap.
 """
 

@@ -5,15 +5,18 @@ Each step (doc/design.md section 13; msg_docs/ExecutePlan.md):
 
 1. measure every robot's tracking error, |reference(s) - position|, at the
    current plan time s;
-2. choose the clock rate: 0 while any robot's odometry is stale, else
-   :func:`clock_rate` of the errors and the tracking tolerance (with
-   ``shared_clock`` off, 1: every robot follows the stamps on its own),
-   rising no faster than the plan's acceleration limit allows;
+2. choose the clock rate: :func:`clock_rate` of the errors and the tracking
+   tolerance, rising no faster than the plan's acceleration limit allows;
+   while any robot's odometry is stale, falling to 0 (at once without the
+   limit, else braking no faster than it rises) and no higher than the
+   others' errors allow (with ``shared_clock`` off, 1: every robot follows
+   the stamps on its own);
 3. advance s by rate x dt (at most the plan's duration);
 4. command each robot feed-forward plus feedback, saturated at its speed
    limit: v = sat(g (rate x reference'(s) + rate^2 dt x reference''(s))
    + gain x (reference(s) - position)), g the robot's learned feed-forward
-   gain. A stale robot gets 0.
+   gain. A stale robot gets its feed-forward alone on the shared clock (0
+   without it, or for a differential robot).
 
 Differential robots (``drive``) track through :mod:`.unicycle` instead: the
 clock sees the bound E = |reference - P| + e of each one's centre error, is
@@ -145,6 +148,9 @@ class Step:
     differential: np.ndarray    # (k,) robots commanded by forward speed and yaw rate
     forward: np.ndarray         # (k,) differential robots' forward speeds (m/s), else 0
     yaw_rates: np.ndarray       # (k,) differential robots' yaw rates (rad/s), else 0
+    # the rate the robots allow (their errors, stale odometry: 0), before the acceleration
+    # limit's rise: what a hold is judged on (execution.hold.ClockHold)
+    allowed: float
 
 
 def behind(lags: np.ndarray, motion: np.ndarray) -> np.ndarray:
@@ -268,14 +274,16 @@ class Execution:
                                watched)
         driving = self._driving(angles)
         watched = watched + self._unseen(ages, dt)
+        # the stale robots' positions say nothing: the others' errors still slow the clock
+        allowed = min(clock_rate(np.where(stale, 0.0, watched), self.tolerance,
+                                 s.slow_fraction, s.hold_fraction),
+                      self._differential_cap(alpha))
         if not s.shared_clock:
-            rate = 1.0
+            rate = allowed = 1.0
         elif stale.any():
-            rate = self._rate_fall(dt)
+            rate, allowed = min(self._rate_fall(dt), allowed), 0.0
         else:
-            rate = self._rate_rise(
-                min(clock_rate(watched, self.tolerance, s.slow_fraction, s.hold_fraction),
-                    self._differential_cap(alpha)), dt)
+            rate = self._rate_rise(allowed, dt)
         self.rate = rate
         duration = self.reference.duration
         self.plan_time = min(duration, self.plan_time + rate * dt)
@@ -291,10 +299,12 @@ class Execution:
             yaw_rates = np.where(differential, unicycle_command.yaw_rate, 0.0)
             velocities = np.where(differential[:, None],
                                   forward[:, None] * unicycle.headings(angles), velocities)
-        # A stale robot's position is unknown: it follows its (braking) reference on its
-        # feed-forward alone; a differential one stops (its heading is unknown too).
-        velocities[stale] = np.where(self.differential[stale, None], 0.0,
-                                     saturate(feedforward[stale], s.speed_limit))
+        # A stale robot's position is unknown: it follows the shared clock's braking
+        # reference on its feed-forward alone; a differential one stops (its heading is
+        # unknown too), and without the shared clock every stale robot does.
+        fed = s.shared_clock & ~self.differential[stale]
+        velocities[stale] = np.where(fed[:, None], saturate(feedforward[stale], s.speed_limit),
+                                     0.0)
         self.commanded_speeds = np.where(differential, np.abs(forward),
                                          np.linalg.norm(velocities, axis=1))
         arrived = bool(self.plan_time >= duration and not stale.any() and np.all(
@@ -302,7 +312,7 @@ class Execution:
         finished = self._settled(arrived, angles, dt) and arrived
         return Step(self.plan_time, rate, target, self.reference.orientation(self.plan_time),
                     velocities, errors, watched, finished, self.differential.copy(), forward,
-                    yaw_rates)
+                    yaw_rates, allowed)
 
     def _measured(self, ages: np.ndarray | None) -> np.ndarray:
         """

@@ -57,16 +57,17 @@ class ClockHold:
     since: float | None = None   # seconds: the first control step of the current hold
     stale: tuple = ()            # names whose odometry went stale during it
 
-    def update(self, rate: float, stale: tuple, now: float, dt: float,
+    def update(self, allowed: float, stale: tuple, now: float, dt: float,
                timeout: float) -> HoldOver | None:
         """
-        Follow one control step (clock rate, stale names, now and dt in seconds).
+        Follow one control step (the rate the robots allow, stale names, now and dt in s).
 
-        Return the HoldOver once the hold lasted timeout (s), else None. The clock
-        moving (at HELD_RATE at least) with fresh odometry ends a hold; the goal's
-        first step (dt = 0, its rate rising from 0) neither starts nor judges one.
+        Return the HoldOver once the hold lasted timeout (s), else None. The robots
+        allowing the clock HELD_RATE at least with fresh odometry end a hold (the rate
+        they allow, not the clock's: under an acceleration limit the clock rises slowly
+        after a hold); the goal's first step (dt = 0) neither starts nor judges one.
         """
-        if rate >= HELD_RATE and not stale:
+        if allowed >= HELD_RATE and not stale:
             self.since, self.stale = None, ()
             return None
         if dt <= 0.0:

@@ -28,8 +28,10 @@ odometry in another frame (``FRAME_MISMATCH``), odometry stale for longer than
 sent zero velocity) or a clock held that long with every robot's odometry
 fresh (``CLOCK_HELD``: a robot that cannot follow), one hold whatever its
 cause. Odometry whose position is not finite or whose orientation is no
-rotation is ignored (warned). A stale robot gets zero velocity from
-the first control step that finds its odometry older than ``odom_timeout``.
+rotation is ignored (warned). From the first control step that finds a
+robot's odometry older than ``odom_timeout`` the clock goes to a hold, braking
+within the plan's acceleration limit with the stale robot on its feed-forward
+alone (execution.Execution).
 Everything runs on one single-threaded executor, so callbacks never overlap.
 A goal still waiting for its plan ends at once when canceled (``CANCELED``),
 when a newer goal comes (``PREEMPTED``: the newest goal always wins) or at a
@@ -465,7 +467,7 @@ class PlanExecutor(Node):
         CLOCK_HELD, naming the robots the clock waits for.
         """
         timeout = self._settings.hold_timeout
-        over = run.hold.update(step.rate, state.stale, now * 1e-9, dt, timeout)
+        over = run.hold.update(step.allowed, state.stale, now * 1e-9, dt, timeout)
         if over is None:
             return False
         held_at = 'the plan clock held %.3f s at plan time %.3f s, hold_timeout %g s' % (
@@ -491,9 +493,9 @@ class PlanExecutor(Node):
         if state.stale == run.stale:
             return
         if state.stale:
-            self.get_logger().warning('plan clock held at %.3f s: odometry of %s is older '
-                                      'than %g s' % (plan_time, ', '.join(state.stale),
-                                                     self._settings.odom_timeout))
+            self.get_logger().warning('plan clock holding from %.3f s: odometry of %s is '
+                                      'older than %g s' % (plan_time, ', '.join(state.stale),
+                                                           self._settings.odom_timeout))
         else:
             self.get_logger().info('odometry back; plan clock resumes at %.3f s' % plan_time)
         run.stale = state.stale

@@ -10,6 +10,7 @@ spin_until_future_complete leaves stale tasks behind.
 from collections.abc import Callable
 from collections.abc import Iterator
 import contextlib
+from dataclasses import dataclass
 import time
 from typing import Any
 
@@ -87,15 +88,23 @@ def wait_for_result(executor: Executor, handle: ClientGoalHandle, watch: GoalWat
     return None
 
 
+@dataclass(frozen=True)
+class Session:
+    """A client's node and the executor that spins it (the node not yet added to it)."""
+
+    node: Node
+    executor: Executor
+
+
 @contextlib.contextmanager
-def session(name: str, namespace: str | None = None) -> Iterator[tuple[Node, Executor]]:
-    """Yield (node, executor) in a private rclpy Context; shut everything down after."""
+def session(name: str, namespace: str | None = None) -> Iterator[Session]:
+    """Yield a Session in a private rclpy Context; shut everything down after."""
     context = rclpy.context.Context()
     rclpy.init(context=context)
     executor = SingleThreadedExecutor(context=context)
     node = rclpy.create_node(name, namespace=namespace, context=context)
     try:
-        yield node, executor
+        yield Session(node, executor)
     finally:
         executor.shutdown()
         node.destroy_node()

@@ -175,6 +175,8 @@ def fleet_state(plan: KnownPlan, odometry: dict[str, RobotOdometry], now_ns: int
         entry = odometry.get(name)
         if entry is None or now_ns - entry.received_ns > timeout_sec * 1e9:
             stale.append(name)
+            if entry is not None:  # its last heading: a stale robot is still commanded
+                orientations[i] = entry.orientation
             continue
         if entry.frame_id and entry.frame_id != plan.frame_id:
             wrong_frame = ('odometry of %s is in frame %r, the plan in %r'

@@ -268,7 +268,8 @@ class Table(Generic[S]):
         renames the node (__node:=) is not checked: its sections carry the new name.
         """
         arguments = list(arguments)
-        if any(argument.startswith(('__node:=', '__name:=')) for argument in arguments):
+        # -r __node:=NAME, or -r planner_node:__node:=NAME for this node alone
+        if any('__node:=' in argument or '__name:=' in argument for argument in arguments):
             return
         paths = [arguments[i + 1] for i, argument in enumerate(arguments[:-1])
                  if argument == '--params-file']
@@ -400,7 +401,7 @@ class FileValues:
     """One node's values from a parameter file, and whether any section of it applies."""
 
     values: dict
-    applies: bool
+    applies: bool   # a section names the node, /**, or rcl's nested form may (ns: {node: })
 
 
 def load_parameter_file(path: str, table: Table) -> dict:
@@ -430,7 +431,8 @@ def read_parameter_file(path: str, table: Table) -> FileValues:
     declares, a ``/**`` section gives only the table's parameters (the others are
     other nodes'), and rclpy's own (use_sim_time) are left out; a name the node's
     own section sets and the table lacks is kept (settings() refuses it: a typo).
-    Raises ValueError for a file that is not a ROS parameter file.
+    rcl's nested form (a namespace mapping to node sections) is not read, but counts
+    as possibly applying. Raises ValueError for a file that is not a ROS parameter file.
     """
     with open(path, encoding='utf-8') as stream:
         data = yaml.safe_load(stream) or {}
@@ -442,6 +444,8 @@ def read_parameter_file(path: str, table: Table) -> FileValues:
         key = str(key)
         shared = key in ('/**', '**')
         if not shared and key.rstrip('/').split('/')[-1] != table.node_name:
+            nested = isinstance(section, dict) and 'ros__parameters' not in section
+            applied = applied or nested
             continue
         applied = True
         if not isinstance(section, dict) or 'ros__parameters' not in section:

@@ -435,9 +435,10 @@ def run_nodes(name: str, make_nodes: Callable[[Context], NodeGroup],
     ``parameters`` table (Table.check_files), initialise a Context with them,
     call ``make_nodes(context)``, spin each node in its thread, wait for a
     stop signal, stop. Returns 0 after a
-    signal, 1 when a callback raised, 2 (with the reason on stderr, after
-    ``name: invalid parameters:``) for a parameter file the node cannot use,
-    arguments rcl refuses, or parameters ``make_nodes`` refused. Call it from
+    signal, 1 when a callback raised, 2 (with the reason on stderr) for a
+    parameter file the node cannot use or parameters ``make_nodes`` refused
+    (``name: invalid parameters:``), or arguments rcl refuses (``name: cannot
+    start:``). Call it from
     the main thread.
     """
     with StopSignals() as signals:
@@ -448,9 +449,12 @@ def run_nodes(name: str, make_nodes: Callable[[Context], NodeGroup],
                 parameters.check_files(sys.argv if args is None else args)
             rclpy.init(args=args, context=context,
                        signal_handler_options=SignalHandlerOptions.NO)
-        except (ValueError, RCLError) as error:
+        except ValueError as error:
+            print('%s: invalid parameters: %s' % (name, error), file=sys.stderr)
+            return EXIT_BAD_PARAMETERS
+        except RCLError as error:  # arguments rcl refuses
             # rcl's reason without its source locations (', at /project/src/...')
-            print('%s: invalid parameters: %s' % (name, str(error).split(', at ')[0]),
+            print('%s: cannot start: %s' % (name, str(error).split(', at ')[0]),
                   file=sys.stderr)
             return EXIT_BAD_PARAMETERS
         try:
