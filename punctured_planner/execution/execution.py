@@ -273,23 +273,31 @@ class Execution:
                                behind(measured_reference - lead_points, motion) + self.lead,
                                watched)
         driving = self._driving(angles)
-        watched = watched + self._unseen(ages, dt)
         # the stale robots' positions say nothing: the others' errors still slow the clock
-        allowed = min(clock_rate(np.where(stale, 0.0, watched), self.tolerance,
-                                 s.slow_fraction, s.hold_fraction),
-                      self._differential_cap(alpha))
+        seen = min(clock_rate(np.where(stale, 0.0, watched), self.tolerance,
+                              s.slow_fraction, s.hold_fraction),
+                   self._differential_cap(alpha))
+        watched = watched + self._unseen(ages, dt)
+        allowed = min(seen, clock_rate(np.where(stale, 0.0, watched), self.tolerance,
+                                       s.slow_fraction, s.hold_fraction))
         if not s.shared_clock:
             rate = allowed = 1.0
         elif stale.any():
-            rate, allowed = min(self._rate_fall(dt), allowed), 0.0
+            rate, allowed = min(self._braked(0.0, dt), seen), 0.0
         else:
-            rate = self._rate_rise(allowed, dt)
+            # what old odometry may hide brakes the clock; what it shows may hold it
+            rate = self._rate_rise(min(seen, self._braked(allowed, dt)), dt)
         self.rate = rate
         duration = self.reference.duration
         self.plan_time = min(duration, self.plan_time + rate * dt)
         target = self.reference.position(self.plan_time)
         feedforward = self._feedforward(rate, dt, measured_reference - positions, stale)
-        command = feedforward + s.gain * (target - positions)
+        # A position older than a control step is where the robot was: its error is its
+        # lag then (it has moved on since, as its reference did), not its distance to the
+        # reference now, which drove a robot whose odometry stopped ever harder ahead.
+        aged = np.zeros(k, dtype=bool) if ages is None else np.asarray(ages) > dt
+        error = np.where(aged[:, None], measured_reference, target) - positions
+        command = feedforward + s.gain * error
         velocities = saturate(command, s.speed_limit)
         forward, yaw_rates = np.zeros(k), np.zeros(k)
         if unicycles:
@@ -345,7 +353,8 @@ class Execution:
         0.5 s is 0.25 m, more than delta. One control step of age is the
         sampling the margin (1 - hold_fraction) delta covers already; the rest
         counts as tracking error, so the clock slows and holds while the
-        positions it sees are old (doc/design.md section 13).
+        positions it sees are old, braking within the acceleration limit
+        (_braked; doc/design.md section 13).
         """
         if ages is None:
             return np.zeros(self.reference.robot_count)
@@ -375,20 +384,23 @@ class Execution:
             return wanted
         return min(wanted, self.rate + self._rate_change() * dt)
 
-    def _rate_fall(self, dt: float) -> float:
+    def _braked(self, wanted: float, dt: float) -> float:
         """
-        Return the clock's rate while some robot's odometry is stale: braking to a hold.
+        Return wanted, or more where the clock would slow down faster than the robots can.
 
-        Without an acceleration limit the clock holds at once. Under one it brakes
+        For what odometry does not show: a robot's stale odometry (wanted 0), and
+        what a robot may have moved since its odometry (_unseen), which grows as
+        fast as the robot goes once its odometry stops and had held the clock
+        within 0.25 s, before the robot even counted as stale. Without an
+        acceleration limit the clock follows wanted at once. Under one it brakes
         no faster than _rate_change, every robot following its braking reference,
         a stale one on its feed-forward alone (step): held at once, each robot at
-        v overran its stopped reference by v^2 / (2 a_i), and a stale one told to
-        stop by its own braking distance (a probe over DDS: 0.25 m against a
-        tolerance of 0.15 m at 1 m/s and 1 m/s^2).
+        v overran its stopped reference by v^2 / (2 a_i) (a probe over DDS: 0.26 m
+        against a tolerance of 0.15 m at 0.75 m/s and 1 m/s^2).
         """
         if self.reference.profile is None:
-            return 0.0
-        return max(0.0, self.rate - self._rate_change() * dt)
+            return wanted
+        return max(wanted, self.rate - self._rate_change() * dt)
 
     def _feedforward(self, rate: float, dt: float, lags: np.ndarray,
                      stale: np.ndarray) -> np.ndarray:
