@@ -410,8 +410,9 @@ def plan_message(outcome: Outcome, settings: PlannerSettings) -> Plan:
     Return the punctured_planner_interfaces/Plan of a successful Outcome (topic ``plan``).
 
     The bodies are the workspace's (robot radius, obstacles and their radii); the
-    tracking tolerance is the response's (fill_response: min_gap and the walls'
-    gap; the walls are not in the message, their gap is in the tolerance).
+    tracking tolerance is the plan's, as in the response (Plan.tracking_tolerance:
+    min_gap and the walls' gap; the walls are not in the message, their gap is in
+    the tolerance).
     """
     planned = outcome.planned()
     plan = planned.plan
@@ -424,7 +425,7 @@ def plan_message(outcome: Outcome, settings: PlannerSettings) -> Plan:
                 robot_radius=float(workspace.robot_radius), obstacles=obstacles,
                 obstacle_radii=np.asarray(workspace.obstacle_radii, dtype=float).tolist(),
                 min_gap=float(plan.min_gap),
-                tracking_tolerance=float(outcome.response.tracking_tolerance))
+                tracking_tolerance=float(plan.tracking_tolerance))
 
 
 @dataclass(frozen=True)
