@@ -243,7 +243,7 @@ class Execution:
         how old the positions are (s; None: fresh): each is compared with its
         reference at the plan time of that instant (:meth:`_measured`), and
         the clock counts what a robot may have moved since, beyond one control
-        step, as error (:meth:`_unseen`).
+        step, as error (:meth:`_late`).
         """
         s = self.settings
         stale = np.asarray(stale, dtype=bool)
@@ -252,7 +252,8 @@ class Execution:
         self.elapsed += max(dt, 0.0)
         self.clock_history.append((self.elapsed, self.plan_time))
         measured_reference = self._measured(ages)
-        errors = np.linalg.norm(measured_reference - positions, axis=1)
+        lags = measured_reference - positions
+        errors = np.linalg.norm(lags, axis=1)
         errors[stale] = 0.0
         self.max_errors = np.maximum(self.max_errors, errors)
         if not stale.any():
@@ -262,7 +263,7 @@ class Execution:
         # An all-holonomic fleet (the default) needs none of the unicycle's work.
         unicycles = bool(self.differential.any())
         motion = self.reference.velocity(self.plan_time)
-        watched, alpha = behind(measured_reference - positions, motion), np.zeros(k)
+        watched, alpha = behind(lags, motion), np.zeros(k)
         if unicycles:
             # a turn may start only while the whole bound E of a robot's centre error is
             # small; the clock then watches only E's part that waiting reduces (behind)
@@ -273,11 +274,12 @@ class Execution:
                                behind(measured_reference - lead_points, motion) + self.lead,
                                watched)
         driving = self._driving(angles)
+        late = self._late(ages, dt)
         # the stale robots' positions say nothing: the others' errors still slow the clock
         seen = min(clock_rate(np.where(stale, 0.0, watched), self.tolerance,
                               s.slow_fraction, s.hold_fraction),
                    self._differential_cap(alpha))
-        watched = watched + self._unseen(ages, dt)
+        watched = watched + late * self.commanded_speeds  # what the robots may have moved
         allowed = min(seen, clock_rate(np.where(stale, 0.0, watched), self.tolerance,
                                        s.slow_fraction, s.hold_fraction))
         if not s.shared_clock:
@@ -291,12 +293,11 @@ class Execution:
         duration = self.reference.duration
         self.plan_time = min(duration, self.plan_time + rate * dt)
         target = self.reference.position(self.plan_time)
-        feedforward = self._feedforward(rate, dt, measured_reference - positions, stale)
+        feedforward = self._feedforward(rate, dt, lags, stale)
         # A position older than a control step is where the robot was: its error is its
         # lag then (it has moved on since, as its reference did), not its distance to the
         # reference now, which drove a robot whose odometry stopped ever harder ahead.
-        aged = np.zeros(k, dtype=bool) if ages is None else np.asarray(ages) > dt
-        error = np.where(aged[:, None], measured_reference, target) - positions
+        error = np.where(late[:, None] > 0.0, lags, target - positions)
         command = feedforward + s.gain * error
         velocities = saturate(command, s.speed_limit)
         forward, yaw_rates = np.zeros(k), np.zeros(k)
@@ -344,21 +345,22 @@ class Execution:
             result[robots] = self.reference.position(float(s_then))[robots]
         return result
 
-    def _unseen(self, ages: np.ndarray | None, dt: float) -> np.ndarray:
+    def _late(self, ages: np.ndarray | None, dt: float) -> np.ndarray:
         """
-        Return the (k,) distances the robots may have moved since their odometry, beyond dt.
+        Return the (k,) seconds by which the robots' odometry is older than a control step.
 
-        A robot whose odometry is a seconds old has moved about a x its speed
+        A robot whose odometry is that late has moved about that x its speed
         since (its last command's speed): at 0.5 m/s a stalled simulator's
         0.5 s is 0.25 m, more than delta. One control step of age is the
         sampling the margin (1 - hold_fraction) delta covers already; the rest
         counts as tracking error, so the clock slows and holds while the
         positions it sees are old, braking within the acceleration limit
-        (_braked; doc/design.md section 13).
+        (_braked; doc/design.md section 13), and the feedback of a late
+        position acts on its lag when measured.
         """
         if ages is None:
             return np.zeros(self.reference.robot_count)
-        return np.maximum(np.asarray(ages, dtype=float) - dt, 0.0) * self.commanded_speeds
+        return np.maximum(np.asarray(ages, dtype=float) - dt, 0.0)
 
     def _rate_change(self) -> float:
         """
@@ -389,7 +391,7 @@ class Execution:
         Return wanted, or more where the clock would slow down faster than the robots can.
 
         For what odometry does not show: a robot's stale odometry (wanted 0), and
-        what a robot may have moved since its odometry (_unseen), which grows as
+        what a robot may have moved since its odometry (_late), which grows as
         fast as the robot goes once its odometry stops and had held the clock
         within 0.25 s, before the robot even counted as stale. Without an
         acceleration limit the clock follows wanted at once. Under one it brakes
