@@ -24,6 +24,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .pairs import point_pairs, PointPair, with_obstacles
+from .planes import box_distance, planes_dot, planes_length, run_boxes
 
 # A clearance is trusted only above this fraction of the coordinate scale: the
 # breakpoints and the closed form each round to a few ulps of the largest
@@ -108,14 +109,6 @@ class _Runs:
     kept: np.ndarray     # (R, pairs) bool
 
 
-def _dot(a, b):
-    """Return the coordinate-wise dot product of coordinate-first arrays (d, ...)."""
-    total = a[0] * b[0]
-    for axis in range(1, a.shape[0]):
-        total += a[axis] * b[axis]
-    return total
-
-
 def segment_minimum(start: np.ndarray, velocity: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """
     Return (min squared distance, t*) of |start + t velocity| over t in [0, 1], elementwise.
@@ -126,8 +119,8 @@ def segment_minimum(start: np.ndarray, velocity: np.ndarray) -> tuple[np.ndarray
     itself, not from |r0|^2 - <r0, v>^2 / |v|^2, which cancels catastrophically
     when robots nearly touch.
     """
-    speed2 = _dot(velocity, velocity)
-    t = _dot(start, velocity)
+    speed2 = planes_dot(velocity, velocity)
+    t = planes_dot(start, velocity)
     # Where nothing moves t is 0 already (a dot product with 0): any divisor keeps it.
     np.maximum(speed2, np.finfo(float).tiny, out=speed2)
     np.divide(t, speed2, out=t)
@@ -136,7 +129,7 @@ def segment_minimum(start: np.ndarray, velocity: np.ndarray) -> tuple[np.ndarray
     np.minimum(t, 1.0, out=t)
     closest = t * velocity
     closest += start
-    return _dot(closest, closest), t
+    return planes_dot(closest, closest), t
 
 
 def _argmin_over_legs(start, end, legs, a, b, offsets=None):
@@ -219,15 +212,11 @@ def _near_runs(planes, a, b, offsets, slack):
     v = planes.shape[1]
     firsts = np.arange(0, v - 1, _RUN_LEGS)
     ends = np.append(firsts[1:], v - 1)
-    low = np.minimum(np.minimum.reduceat(planes[:, :-1], firsts, axis=1), planes[:, ends])
-    high = np.maximum(np.maximum.reduceat(planes[:, :-1], firsts, axis=1), planes[:, ends])
-    gap = np.take(low, a, axis=-1) - np.take(high, b, axis=-1)
-    np.maximum(gap, np.take(low, b, axis=-1) - np.take(high, a, axis=-1), out=gap)
-    np.maximum(gap, 0.0, out=gap)
-    lower = np.sqrt(_dot(gap, gap))
+    low, high = run_boxes(planes, firsts, ends)
+    lower = box_distance(np.take(low, a, axis=-1), np.take(high, a, axis=-1),
+                         np.take(low, b, axis=-1), np.take(high, b, axis=-1))
     lower -= slack
-    at_starts = _pair_differences(planes[:, np.append(firsts, v - 1)], a, b)
-    upper = np.sqrt(_dot(at_starts, at_starts))
+    upper = planes_length(_pair_differences(planes[:, np.append(firsts, v - 1)], a, b))
     kept = np.zeros(lower.shape, dtype=bool)
     for offset in offsets:
         kept |= lower - offset <= float((upper - offset).min())

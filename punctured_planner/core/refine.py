@@ -41,6 +41,7 @@ import numpy as np
 
 from .certificate import BOUND_SLACK, certify, evaluates_every_pair, segment_minimum
 from .pairs import point_pairs
+from .planes import box_distance, planes_length, run_boxes
 from .timing import leg_at
 from .walls import wall_slack
 
@@ -195,26 +196,6 @@ class _Knots:
         return (1.0 - f) * values[self.interval] + f * values[self.interval + 1]
 
 
-def _interval_boxes(planes, points):
-    """
-    Return (low, high), each (d, N - 1, k): every robot's bounding box over each knot interval.
-
-    The motion is linear between the union's breakpoints, so the box of a robot's
-    breakpoints from points[i] to points[i + 1] holds all of its interval i.
-    """
-    low = np.minimum(np.minimum.reduceat(planes, points[:-1], axis=1), planes[:, points[1:]])
-    high = np.maximum(np.maximum.reduceat(planes, points[:-1], axis=1), planes[:, points[1:]])
-    return low, high
-
-
-def _planes_length(planes):
-    """Return the lengths (...) of coordinate-first vectors (d, ...)."""
-    squared = planes[0] * planes[0]
-    for axis in range(1, planes.shape[0]):
-        squared += planes[axis] * planes[axis]
-    return np.sqrt(squared)
-
-
 @lru_cache(maxsize=8)
 def _pair_groups(k):
     """
@@ -258,7 +239,7 @@ def _knot_partners(knots):
     for first in range(0, count, rows):
         piece = knots[:, first:first + rows]
         with np.errstate(over='ignore'):
-            distance = _planes_length(np.take(piece, a, axis=2) - np.take(piece, b, axis=2))
+            distance = planes_length(np.take(piece, a, axis=2) - np.take(piece, b, axis=2))
         nearest = _pair_minimum(distance, k)
         found = partners[first:first + rows]
         # A pair at a robot's smallest distance names its partner.
@@ -297,18 +278,12 @@ def _near_pairs(planes, points, runs, a, b, margin, partners):
     lasts = np.array([last for _, last in runs])
     knots = planes[:, points[firsts[0]:lasts[-1]]]
     partner = np.take_along_axis(knots, partners[None, firsts[0]:lasts[-1]], axis=2)
-    near = np.maximum.reduceat(_planes_length(knots - partner), firsts - firsts[0], axis=0)
+    near = np.maximum.reduceat(planes_length(knots - partner), firsts - firsts[0], axis=0)
     near += margin
-    begins, ends = points[firsts], points[lasts]
-    piece = planes[:, begins[0]:ends[-1] + 1]
-    # The motion is linear between breakpoints: their box over a run holds all of it.
-    low = np.minimum(np.minimum.reduceat(piece, begins - begins[0], axis=1), planes[:, ends])
-    high = np.maximum(np.maximum.reduceat(piece, begins - begins[0], axis=1), planes[:, ends])
-    gap = np.maximum(np.take(low, a, axis=2) - np.take(high, b, axis=2),
-                     np.take(low, b, axis=2) - np.take(high, a, axis=2))
-    np.maximum(gap, 0.0, out=gap)
-    return _planes_length(gap) - margin <= np.maximum(np.take(near, a, axis=1),
-                                                      np.take(near, b, axis=1))
+    low, high = run_boxes(planes, points[firsts], points[lasts])
+    apart = box_distance(np.take(low, a, axis=2), np.take(high, a, axis=2),
+                         np.take(low, b, axis=2), np.take(high, b, axis=2))
+    return apart - margin <= np.maximum(np.take(near, a, axis=1), np.take(near, b, axis=1))
 
 
 def _near_pillars(planes, points, runs, pillars, offsets, margin):
@@ -325,15 +300,11 @@ def _near_pillars(planes, points, runs, pillars, offsets, margin):
     centres = pillars.T[:, :, None, None]
     pillar_offsets = offsets.T[:, None]
     knots = planes[:, None, points[firsts[0]:lasts[-1]]]
-    nearest = (_planes_length(knots - centres) - pillar_offsets).min(axis=0)
+    nearest = (planes_length(knots - centres) - pillar_offsets).min(axis=0)
     near = np.maximum.reduceat(nearest, firsts - firsts[0], axis=0) + margin
-    begins, ends = points[firsts], points[lasts]
-    piece = planes[:, begins[0]:ends[-1] + 1]
-    low = np.minimum(np.minimum.reduceat(piece, begins - begins[0], axis=1), planes[:, ends])
-    high = np.maximum(np.maximum.reduceat(piece, begins - begins[0], axis=1), planes[:, ends])
-    gap = np.maximum(low[:, None] - centres, centres - high[:, None])
-    np.maximum(gap, 0.0, out=gap)
-    keep = _planes_length(gap) - pillar_offsets - margin <= near
+    low, high = run_boxes(planes, points[firsts], points[lasts])
+    apart = box_distance(low[:, None], high[:, None], centres, centres)
+    keep = apart - pillar_offsets - margin <= near
     return np.transpose(keep, (1, 2, 0)).reshape(len(runs), -1)
 
 
@@ -482,7 +453,8 @@ class _Caps:
         self.pair, self.pillar = _knot_caps(pair), _knot_caps(pillar)
         self.lower = self.upper = self.inward = None
         if constraints.bounds is not None:
-            self._walls(_interval_boxes(nearest.planes, knots.points), constraints, step)
+            boxes = run_boxes(nearest.planes, knots.points[:-1], knots.points[1:])
+            self._walls(boxes, constraints, step)
 
     def _walls(self, boxes, constraints, step):
         """
@@ -533,7 +505,7 @@ def _knots_last(values):
 
 def _clipped(move, caps):
     """Return the moves (d, ...) scaled down to lengths <= caps (...), in place; 0 at cap 0."""
-    length = _planes_length(move)
+    length = planes_length(move)
     # caps / length where a move is longer than its cap, else 1: the quotient rounds to
     # >= 1 wherever length <= caps, and fmin takes 1 for the 0 / 0 of a zero move at cap 0
     # (a masked division costs three times as much).
@@ -586,7 +558,7 @@ class _Block:
         if self.lower is not None:
             # Within every robot's wall limits, so each robot's own part has room around 0.
             common = np.clip(common, *self.common_range)
-        left = self.pillar - _planes_length(common)
+        left = self.pillar - planes_length(common)
         own = _clipped(np.subtract(wanted, common, out=wanted), np.minimum(self.own_cap, left))
         if self.lower is not None:
             own = np.clip(own, -self.lower - common, self.upper - common)
