@@ -5,7 +5,10 @@ import os
 
 from conftest import REPO_ROOT
 import numpy as np
+from punctured_planner.execution.execution import WrongCount
 from punctured_planner.ros.parameters import FRAME_ID
+from punctured_planner.ros.parameters import InvalidParameter
+from punctured_planner.ros.parameters import InvalidParameterFile
 from punctured_planner.ros.parameters import load_parameter_file
 from punctured_planner.ros.settings import EXECUTOR
 from punctured_planner.ros.settings import FLEET_SIM
@@ -62,6 +65,35 @@ def test_workspace_bounds_are_refused_exactly_where_the_core_refuses_them(values
     assert 'for dimension 2 (x_min, x_max, y_min, y_max)' in reason
 
 
+@pytest.mark.parametrize('table, values, parameters, index', [
+    (PLANNER, {'robot_names': ['a', 'a b']}, ('robot_names',), 1),
+    (PLANNER, {'obstacle_radius': [0.1, 1e-300]}, ('obstacle_radius',), 1),
+    (PLANNER, {'robot_radius': 1e-200}, ('robot_radius',), None),
+    (PLANNER, {'robot_names': ['a'], 'robot_count': 2}, ('robot_count', 'robot_names'), None),
+    (PLANNER, {'workspace_bounds': [0.0, 1.0, 0.0]}, ('workspace_bounds', 'dimension'), None),
+    (PLANNER, {'nonsense': 1}, ('nonsense',), None),
+    (EXECUTOR, {'slow_fraction': 0.7}, ('slow_fraction', 'hold_fraction'), None),
+    (EXECUTOR, {'drive': ['holonomic', 'tank']}, ('drive',), 1),
+    (FLEET_SIM, {'robot_names': ['a'], 'initial_positions': [0.0] * 3,
+                 'muted_robots': ['a', 'b']}, ('muted_robots', 'robot_names'), 1),
+    (FLEET_SIM, {'robot_names': ['a'], 'initial_positions': [0.0] * 3,
+                 'speed_factors': [11.0]}, ('speed_factors',), 0),
+])
+def test_a_refused_value_carries_its_parameters_and_element(table, values, parameters, index):
+    """The culprits as data: the parameter refused first, any it does not fit, the element."""
+    with pytest.raises(InvalidParameter) as refused:
+        table.settings(values)
+    assert (refused.value.parameters, refused.value.index) == (parameters, index)
+
+
+def test_a_count_that_fits_neither_all_nor_each_carries_its_counts():
+    with pytest.raises(WrongCount) as refused:
+        FLEET_SIM.settings({'robot_names': ['a', 'b'], 'initial_positions': [0.0] * 6,
+                            'max_acceleration': [1.0, 0.5, 2.0]})
+    assert (refused.value.name, refused.value.given, refused.value.expected,
+            refused.value.items) == ('max_acceleration', 3, 2, 'robots')
+
+
 def test_workspace_bounds_become_the_cores_box_for_the_dimension():
     """Empty: no walls; 4 values in the plane, 6 in 3-D, each axis [min, max]."""
     assert PLANNER.settings({}).core_bounds is None
@@ -107,8 +139,14 @@ def test_a_nodes_parameter_files_are_checked_together(tmp_path):
     others.write_text('/**/plan_executor:\n  ros__parameters: {gain: 1.0}\n')
     PLANNER.check_files(['planner_node', '--ros-args', '--params-file', str(own),
                          '--params-file', str(others)])
-    with pytest.raises(ValueError, match='no section applies to planner_node'):
+    with pytest.raises(InvalidParameterFile, match='no section applies to planner_node') as no:
         PLANNER.check_files(['--ros-args', '--params-file', str(others)])
+    assert (no.value.paths, no.value.parameter) == ((str(others),), None)
+    typo = tmp_path / 'typo.yaml'
+    typo.write_text('planner_node:\n  ros__parameters: {max_sped: 2.0}\n')
+    with pytest.raises(InvalidParameterFile) as unknown:
+        PLANNER.check_files(['--ros-args', '--params-file', str(own), '--params-file', str(typo)])
+    assert (unknown.value.paths, unknown.value.parameter) == ((str(typo),), 'max_sped')
     # renamed, its sections carry the new name: not checked
     for rename in ('__node:=fleet_planner', 'planner_node:__node:=fleet_planner'):
         PLANNER.check_files(['--ros-args', '-r', rename, '--params-file', str(others)])

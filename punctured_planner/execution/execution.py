@@ -90,13 +90,31 @@ class ExecutionSettings:
     max_accelerations: tuple = ()
 
     def differential(self, robot_count: int) -> np.ndarray:
-        """Return the (k,) mask of differential robots; ValueError if drive does not fit k."""
+        """Return the (k,) mask of differential robots; WrongCount if drive does not fit k."""
         return differential_mask(self.drive, robot_count)
 
     def limits(self, robot_count: int) -> tuple[np.ndarray | None, np.ndarray | None]:
-        """Return (k,) max_speeds and max_accelerations (None: the plan's); ValueError on k."""
+        """Return (k,) max_speeds and max_accelerations (None: the plan's); WrongCount on k."""
         return (per_robot('max_speeds', self.max_speeds, robot_count),
                 per_robot('max_accelerations', self.max_accelerations, robot_count))
+
+
+class WrongCount(ValueError):
+    """
+    Values for all or for each item, of neither count: the setting, its count and the items'.
+
+    name is the setting at fault (a parameter's name), given how many values it
+    has, expected how many items there are (robots, obstacles).
+    """
+
+    def __init__(self, name: str, given: int, expected: int, items: str) -> None:
+        """Keep the culprits; the message names them."""
+        self.name = name
+        self.given = given
+        self.expected = expected
+        self.items = items
+        super().__init__('%s has %d values for %d %s (one, or one per %s)'
+                         % (name, given, expected, items, items[:-1]))
 
 
 def one_or_each(name: str, values: Sequence, count: int,
@@ -105,13 +123,12 @@ def one_or_each(name: str, values: Sequence, count: int,
     Return values, one for all or one per item, as a (count,) array; None for none.
 
     The rule of every parameter that gives one value for all robots (obstacles) or
-    one each; ValueError naming the parameter for any other count.
+    one each; WrongCount naming the parameter for any other count.
     """
     if not len(values):
         return None
     if len(values) not in (1, count):
-        raise ValueError('%s has %d values for %d %s (one, or one per %s)'
-                         % (name, len(values), count, items, items[:-1]))
+        raise WrongCount(name, len(values), count, items)
     return np.broadcast_to(np.asarray(values), count).copy()
 
 
@@ -183,7 +200,7 @@ class Execution:
     def __init__(self, reference: Reference, tolerance: float, settings: ExecutionSettings,
                  bodies: Bodies | None = None):
         """
-        Start at plan time 0 with no error measured yet; ValueError if drive does not fit.
+        Start at plan time 0 with no error measured yet; WrongCount if drive does not fit.
 
         The clock runs on the plan retimed (Reference.retimed) for robots slower
         than the plan (settings.max_speeds), and, for a plan timed under an

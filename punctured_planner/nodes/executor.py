@@ -71,6 +71,7 @@ from ..execution import Execution
 from ..execution import Step
 from ..execution.execution import differential_mask
 from ..execution.execution import leaving_their_plane
+from ..execution.execution import WrongCount
 from ..execution.hold import ClockHold
 from ..execution.hold import off_start
 from ..execution.hold import waited_for
@@ -352,15 +353,17 @@ class PlanExecutor(Node):
         try:
             differential = differential_mask(settings.drive, count)
             settings.limits(count)
+        except WrongCount as error:
+            reason = str(error)
+        else:
             climbing = leaving_their_plane(differential, plan.reference)
-            if climbing.size:
-                raise ValueError('drive makes %s differential, and a differential robot moves '
-                                 'in its plane only: its path changes z'
-                                 % ', '.join(plan.names[i] for i in climbing))
-        except ValueError as error:
-            return Lookup(plan, Result.UNKNOWN_ROBOTS, 'plan %d has robots %s: %s'
-                          % (plan.plan_id, ', '.join(plan.names), error))
-        return Lookup(plan, Result.NONE)
+            if not climbing.size:
+                return Lookup(plan, Result.NONE)
+            reason = ('drive makes %s differential, and a differential robot moves in its '
+                      'plane only: its path changes z'
+                      % ', '.join(plan.names[i] for i in climbing))
+        return Lookup(plan, Result.UNKNOWN_ROBOTS, 'plan %d has robots %s: %s'
+                      % (plan.plan_id, ', '.join(plan.names), reason))
 
     def _end(self, run: Run, code: int, message: str) -> None:
         """Stop the run's robots, then end its goal with code and message."""

@@ -50,12 +50,45 @@ _LIST_TYPES = {'string_array': 'STRING_ARRAY', 'double_array': 'DOUBLE_ARRAY'}
 _NAME = re.compile(r'^[A-Za-z_][A-Za-z0-9_]*(/[A-Za-z_][A-Za-z0-9_]*)*$')
 
 
+class InvalidParameter(ValueError):
+    """
+    A parameter value refused, with its culprits: the parameters at fault and the element.
+
+    parameters names the parameter refused first, then any other whose value it
+    does not fit (robot_count and robot_names); index is the list element at
+    fault, where one is. The message says why, naming them.
+    """
+
+    def __init__(self, parameters: str | tuple[str, ...], message: str,
+                 index: int | None = None) -> None:
+        """Keep the culprits; message is the reason, worded with them."""
+        self.parameters = (parameters,) if isinstance(parameters, str) else tuple(parameters)
+        self.index = index
+        super().__init__(message)
+
+
+class InvalidParameterFile(ValueError):
+    """
+    A --params-file a node cannot use, with its culprits: the file and, where one is, the name.
+
+    paths are the files at fault (every file where none of them applies),
+    parameter the unknown name in the node's own section, if that is the fault.
+    """
+
+    def __init__(self, paths: Sequence[str], message: str,
+                 parameter: str | None = None) -> None:
+        """Keep the culprits; message is the reason, worded with them."""
+        self.paths = tuple(paths)
+        self.parameter = parameter
+        super().__init__(message)
+
+
 @dataclass(frozen=True)
 class Spec:
     """
     One parameter: name, kind, default, range (inclusive) or choices, check, description.
 
-    ``check(name, value)`` raises ValueError with the reason for a value of
+    ``check(name, value)`` raises InvalidParameter with the reason for a value of
     the right kind that is still refused; ``prose`` says in words what the
     check accepts (the descriptor's additional_constraints).
     """
@@ -85,14 +118,14 @@ class Spec:
         return dataclasses.field(default=default, metadata={'spec': self})
 
     def value(self, raw: object) -> Any:
-        """Return raw converted to the parameter's kind and checked; raise ValueError (reason)."""
+        """Return raw converted to the parameter's kind and checked; raise InvalidParameter."""
         value = _coerce(self, raw)
         if self.low is not None and not self.low <= value <= self.high:
-            raise ValueError('%s must be in [%s, %s], got %r'
-                             % (self.name, self.low, self.high, value))
+            raise InvalidParameter(self.name, '%s must be in [%s, %s], got %r'
+                                   % (self.name, self.low, self.high, value))
         if self.choices and value not in self.choices:
-            raise ValueError('%s must be one of %s, got %r'
-                             % (self.name, ', '.join(self.choices), value))
+            raise InvalidParameter(self.name, '%s must be one of %s, got %r'
+                                   % (self.name, ', '.join(self.choices), value))
         if self.check is not None:
             self.check(self.name, value)
         return value
@@ -120,42 +153,49 @@ def _is_number(value: object) -> bool:
 
 
 def _coerce(spec: Spec, value: object) -> Any:
-    """Return value converted to the parameter's kind, or raise ValueError with a reason."""
+    """Return value converted to the parameter's kind, or raise InvalidParameter."""
     if spec.kind == 'string':
         if not isinstance(value, str):
-            raise ValueError('%s must be a string, got %r' % (spec.name, value))
+            raise InvalidParameter(spec.name, '%s must be a string, got %r'
+                                   % (spec.name, value))
         return value
     if spec.kind == 'bool':
         if not isinstance(value, bool):
-            raise ValueError('%s must be true or false, got %r' % (spec.name, value))
+            raise InvalidParameter(spec.name, '%s must be true or false, got %r'
+                                   % (spec.name, value))
         return value
     if spec.kind == 'integer':
         if not isinstance(value, int) or isinstance(value, bool):
-            raise ValueError('%s must be an integer, got %r' % (spec.name, value))
+            raise InvalidParameter(spec.name, '%s must be an integer, got %r'
+                                   % (spec.name, value))
         return int(value)
     if spec.kind == 'double':
         if not _is_number(value):
-            raise ValueError('%s must be a number, got %r' % (spec.name, value))
+            raise InvalidParameter(spec.name, '%s must be a number, got %r'
+                                   % (spec.name, value))
         number = float(value)  # type: ignore[arg-type]  # a number, checked above
         if not math.isfinite(number):
-            raise ValueError('%s must be finite, got %r' % (spec.name, number))
+            raise InvalidParameter(spec.name, '%s must be finite, got %r'
+                                   % (spec.name, number))
         return number
     if value is None:
         return ()
     if isinstance(value, (str, bytes)) or not isinstance(value, Iterable):
-        raise ValueError('%s must be a list, got %r' % (spec.name, value))
+        raise InvalidParameter(spec.name, '%s must be a list, got %r' % (spec.name, value))
     items = list(value)
     if spec.kind == 'string_array':
         if not all(isinstance(item, str) for item in items):
-            raise ValueError('%s must be a list of strings, got %r' % (spec.name, items))
+            raise InvalidParameter(spec.name, '%s must be a list of strings, got %r'
+                                   % (spec.name, items))
         return tuple(items)
     if not all(_is_number(item) for item in items):
-        raise ValueError('%s must be a list of numbers, got %r' % (spec.name, items))
+        raise InvalidParameter(spec.name, '%s must be a list of numbers, got %r'
+                               % (spec.name, items))
     numbers = tuple(float(item) for item in items)
     bad = [i for i, item in enumerate(numbers) if not math.isfinite(item)]
     if bad:
-        raise ValueError('%s[%d] is %r: values must be finite'
-                         % (spec.name, bad[0], numbers[bad[0]]))
+        raise InvalidParameter(spec.name, '%s[%d] is %r: values must be finite'
+                               % (spec.name, bad[0], numbers[bad[0]]), index=bad[0])
     return numbers
 
 
@@ -164,17 +204,17 @@ def _coerce(spec: Spec, value: object) -> Any:
 def frame_name(name: str, value: str) -> None:
     """Refuse what tf2 cannot take as a frame id: empty, with whitespace, or a leading '/'."""
     if not value:
-        raise ValueError('%s must not be empty' % name)
+        raise InvalidParameter(name, '%s must not be empty' % name)
     if value.startswith('/') or any(character.isspace() for character in value):
-        raise ValueError("%s %r is not a frame id: tf2 takes no leading '/' and no "
-                         'whitespace' % (name, value))
+        raise InvalidParameter(name, "%s %r is not a frame id: tf2 takes no leading '/' and "
+                               'no whitespace' % (name, value))
 
 
 def triples(name: str, value: tuple) -> None:
     """Refuse a flat list that is not x, y, z per point."""
     if len(value) % 3:
-        raise ValueError('%s must hold x, y, z per obstacle: %d values is not a multiple of 3'
-                         % (name, len(value)))
+        raise InvalidParameter(name, '%s must hold x, y, z per obstacle: %d values is not a '
+                               'multiple of 3' % (name, len(value)))
 
 
 def lengths(name: str, value: float | tuple) -> None:
@@ -182,17 +222,19 @@ def lengths(name: str, value: float | tuple) -> None:
     values = np.atleast_1d(np.asarray(value, dtype=float))
     bad = np.flatnonzero(~lengths_in_range(values, zero=True))
     if bad.size:
-        raise ValueError('%s: every value must be %s, got %r'
-                         % (name, length_range(zero=True), float(values[bad[0]])))
+        raise InvalidParameter(name, '%s: every value must be %s, got %r'
+                               % (name, length_range(zero=True), float(values[bad[0]])),
+                               index=int(bad[0]) if np.ndim(value) else None)
 
 
 def ros_names(name: str, value: tuple) -> None:
     """Refuse names that are not unique relative ROS names."""
     for item in value:
         if not _NAME.match(item):
-            raise ValueError('%s: %r is not a valid relative ROS name' % (name, item))
+            raise InvalidParameter(name, '%s: %r is not a valid relative ROS name'
+                                   % (name, item), index=value.index(item))
     if len(set(value)) != len(value):
-        raise ValueError('%s must be unique, got %r' % (name, list(value)))
+        raise InvalidParameter(name, '%s must be unique, got %r' % (name, list(value)))
 
 
 def within(low: float, high: float) -> Callable[[str, tuple], None]:
@@ -200,8 +242,8 @@ def within(low: float, high: float) -> Callable[[str, tuple], None]:
     def check(name: str, value: tuple) -> None:
         bad = [i for i, item in enumerate(value) if not low <= item <= high]
         if bad:
-            raise ValueError('%s[%d] = %r is outside [%g, %g]'
-                             % (name, bad[0], value[bad[0]], low, high))
+            raise InvalidParameter(name, '%s[%d] = %r is outside [%g, %g]'
+                                   % (name, bad[0], value[bad[0]], low, high), index=bad[0])
     return check
 
 
@@ -240,7 +282,7 @@ class Table(Generic[S]):
     A node's parameters: the specs of a settings dataclass, and the settings from values.
 
     ``checks`` are the cross-parameter rules: each takes the settings and
-    raises ValueError with the reason.
+    raises InvalidParameter with the reason.
     """
 
     def __init__(self, node_name: str, settings_type: type[S],
@@ -257,7 +299,7 @@ class Table(Generic[S]):
 
     def check_files(self, arguments: Sequence[str]) -> None:
         """
-        Raise ValueError for a --params-file of a node's command line the node cannot use.
+        Raise InvalidParameterFile for a --params-file of the command line the node cannot use.
 
         rcl refuses a file it cannot parse, with a traceback; a node starts on its
         defaults from files none of whose sections applies to it (a misspelt section
@@ -278,31 +320,34 @@ class Table(Generic[S]):
             try:
                 read = read_parameter_file(path, self)
             except OSError as error:
-                raise ValueError('--params-file %s: %s' % (path, error.strerror)) from None
+                raise InvalidParameterFile([path], '--params-file %s: %s'
+                                           % (path, error.strerror)) from None
             except yaml.YAMLError as error:
-                raise ValueError('--params-file %s: not YAML: %s' % (
+                raise InvalidParameterFile([path], '--params-file %s: not YAML: %s' % (
                     path, ' '.join(str(error).split()))) from None
             applies = applies or read.applies
             unknown = sorted(set(read.values) - set(self.by_name))
             if unknown:
-                raise ValueError('%s: unknown parameter %r of %s (parameters: %s)'
-                                 % (path, unknown[0], self.node_name,
-                                    ', '.join(self.by_name)))
+                raise InvalidParameterFile(
+                    [path], '%s: unknown parameter %r of %s (parameters: %s)'
+                    % (path, unknown[0], self.node_name, ', '.join(self.by_name)),
+                    parameter=unknown[0])
         if not applies:
-            raise ValueError('--params-file %s: %s' % (', '.join(paths), _no_section(self)))
+            raise InvalidParameterFile(paths, '--params-file %s: %s'
+                                       % (', '.join(paths), _no_section(self)))
 
     def settings(self, values: dict) -> S:
         """
         Return the settings of parameter values (missing names keep their defaults).
 
-        Raises ValueError whose message is the reason a value is refused; unknown
-        names are refused too.
+        Raises InvalidParameter (a ValueError) whose message is the reason a value is
+        refused; unknown names are refused too.
         """
         merged = {}
         for name, value in values.items():
             if name not in self.by_name:
-                raise ValueError('unknown parameter %r (parameters: %s)'
-                                 % (name, ', '.join(self.by_name)))
+                raise InvalidParameter(name, 'unknown parameter %r (parameters: %s)'
+                                       % (name, ', '.join(self.by_name)))
             merged[name] = self.by_name[name].value(value)
         settings = self.settings_type(**merged)
         for check in self._checks:
@@ -408,12 +453,12 @@ def load_parameter_file(path: str, table: Table) -> dict:
     """
     Return one node's parameter values from a ROS 2 parameter YAML file.
 
-    As read_parameter_file; raises ValueError for a file none of whose sections
-    applies to the node, too.
+    As read_parameter_file; raises InvalidParameterFile for a file none of whose
+    sections applies to the node, too.
     """
     read = read_parameter_file(path, table)
     if not read.applies:
-        raise ValueError('%s: %s' % (path, _no_section(table)))
+        raise InvalidParameterFile([path], '%s: %s' % (path, _no_section(table)))
     return read.values
 
 
@@ -432,12 +477,14 @@ def read_parameter_file(path: str, table: Table) -> FileValues:
     other nodes'), and rclpy's own (use_sim_time) are left out; a name the node's
     own section sets and the table lacks is kept (settings() refuses it: a typo).
     rcl's nested form (a namespace mapping to node sections) is not read, but counts
-    as possibly applying. Raises ValueError for a file that is not a ROS parameter file.
+    as possibly applying. Raises InvalidParameterFile for a file that is not a ROS
+    parameter file.
     """
     with open(path, encoding='utf-8') as stream:
         data = yaml.safe_load(stream) or {}
     if not isinstance(data, dict):
-        raise ValueError('%s: not a ROS parameter file (a mapping of node names)' % path)
+        raise InvalidParameterFile([path], '%s: not a ROS parameter file (a mapping of node '
+                                   'names)' % path)
     values: dict = {}
     applied = False
     for key, section in data.items():
@@ -449,11 +496,12 @@ def read_parameter_file(path: str, table: Table) -> FileValues:
             continue
         applied = True
         if not isinstance(section, dict) or 'ros__parameters' not in section:
-            raise ValueError('%s: section %r has no ros__parameters' % (path, key))
+            raise InvalidParameterFile([path], '%s: section %r has no ros__parameters'
+                                       % (path, key))
         parameters = section['ros__parameters'] or {}
         if not isinstance(parameters, dict):
-            raise ValueError('%s: section %r: ros__parameters must map names to values, got %r'
-                             % (path, key, parameters))
+            raise InvalidParameterFile([path], '%s: section %r: ros__parameters must map names '
+                                       'to values, got %r' % (path, key, parameters))
         values.update((name, value) for name, value in parameters.items()
                       if name not in RCLPY_PARAMETERS
                       and (name in table.by_name or not shared))

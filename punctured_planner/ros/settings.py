@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .parameters import FRAME_ID
+from .parameters import InvalidParameter
 from .parameters import lengths
 from .parameters import OBSTACLE_RADIUS
 from .parameters import OBSTACLES
@@ -174,12 +175,14 @@ class PlannerSettings:
 def _planner_robot_count(settings: PlannerSettings) -> None:
     """Refuse a robot_count other than robot_names'; more robots than max_robots."""
     if settings.robot_names and settings.robot_count not in (0, len(settings.robot_names)):
-        raise ValueError('robot_count %d differs from the %d robot_names; set robot_count to '
-                         '0 or to their number' % (settings.robot_count,
-                                                   len(settings.robot_names)))
+        raise InvalidParameter(('robot_count', 'robot_names'),
+                               'robot_count %d differs from the %d robot_names; set robot_count '
+                               'to 0 or to their number' % (settings.robot_count,
+                                                            len(settings.robot_names)))
     if settings.expected_robot_count > settings.max_robots:
-        raise ValueError('%d robots configured but max_robots is %d'
-                         % (settings.expected_robot_count, settings.max_robots))
+        raise InvalidParameter(('max_robots', 'robot_count', 'robot_names'),
+                               '%d robots configured but max_robots is %d'
+                               % (settings.expected_robot_count, settings.max_robots))
 
 
 def _planner_bounds(settings: PlannerSettings) -> None:
@@ -187,11 +190,13 @@ def _planner_bounds(settings: PlannerSettings) -> None:
     try:
         checked_bounds(settings.core_bounds, settings.dimension)
     except PlanningError as error:  # its reason without the code, the wall by its entry
-        raise ValueError('workspace_bounds %r for dimension %d (%s): %s'
-                         % (list(settings.workspace_bounds), settings.dimension,
-                            ', '.join(Wall(axis, high).name for axis in range(settings.dimension)
-                                      for high in (False, True)),
-                            error.describe(WallNames()))) from None
+        raise InvalidParameter(('workspace_bounds', 'dimension'),
+                               'workspace_bounds %r for dimension %d (%s): %s'
+                               % (list(settings.workspace_bounds), settings.dimension,
+                                  ', '.join(Wall(axis, high).name
+                                            for axis in range(settings.dimension)
+                                            for high in (False, True)),
+                                  error.describe(WallNames()))) from None
 
 
 PLANNER = Table('planner_node', PlannerSettings,
@@ -201,11 +206,11 @@ PLANNER = Table('planner_node', PlannerSettings,
 def _drives(name: str, value: tuple) -> None:
     """Refuse an empty drive list or an entry that is not a known drive."""
     if not value:
-        raise ValueError('%s must hold one value or one per robot, got []' % name)
+        raise InvalidParameter(name, '%s must hold one value or one per robot, got []' % name)
     bad = [i for i, item in enumerate(value) if item not in DRIVES]
     if bad:
-        raise ValueError('%s[%d] = %r is not one of %s'
-                         % (name, bad[0], value[bad[0]], ', '.join(DRIVES)))
+        raise InvalidParameter(name, '%s[%d] = %r is not one of %s'
+                               % (name, bad[0], value[bad[0]], ', '.join(DRIVES)), index=bad[0])
 
 
 # The robots' drive, for the executor's tracking law and the simulator's kinematics alike.
@@ -317,8 +322,9 @@ class ExecutorSettings:
 def _slow_below_hold(settings: ExecutorSettings) -> None:
     """Refuse a slow_fraction not below hold_fraction: the clock slows before it holds."""
     if not settings.slow_fraction < settings.hold_fraction:
-        raise ValueError('slow_fraction %g must be below hold_fraction %g'
-                         % (settings.slow_fraction, settings.hold_fraction))
+        raise InvalidParameter(('slow_fraction', 'hold_fraction'),
+                               'slow_fraction %g must be below hold_fraction %g'
+                               % (settings.slow_fraction, settings.hold_fraction))
 
 
 EXECUTOR = Table('plan_executor', ExecutorSettings, checks=(_slow_below_hold,))
@@ -416,17 +422,21 @@ def _fleet_counts(settings: FleetSimSettings) -> None:
     """Refuse other than 3 coordinates, one factor, latency and drive per robot; unknown muted."""
     count = len(settings.robot_names)
     if len(settings.initial_positions) != 3 * count:
-        raise ValueError('initial_positions has %d values for %d robot_names (3 per robot)'
-                         % (len(settings.initial_positions), count))
+        raise InvalidParameter(('initial_positions', 'robot_names'),
+                               'initial_positions has %d values for %d robot_names (3 per '
+                               'robot)' % (len(settings.initial_positions), count))
     for name in ('speed_factors', 'latencies'):
         values = getattr(settings, name)
         if values and len(values) != count:
-            raise ValueError('%s has %d values for %d robots' % (name, len(values), count))
+            raise InvalidParameter((name, 'robot_names'), '%s has %d values for %d robots'
+                                   % (name, len(values), count))
     differential_mask(settings.drive, count)
     one_or_each('max_acceleration', settings.max_acceleration, count)
     unknown = [name for name in settings.muted_robots if name not in settings.robot_names]
     if unknown:
-        raise ValueError('muted_robots names %s, not among robot_names' % ', '.join(unknown))
+        raise InvalidParameter(('muted_robots', 'robot_names'),
+                               'muted_robots names %s, not among robot_names'
+                               % ', '.join(unknown), index=settings.muted_robots.index(unknown[0]))
     one_or_each('obstacle_radius', settings.obstacle_radius, len(settings.obstacles) // 3,
                 'obstacles')
 
