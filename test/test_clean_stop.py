@@ -11,6 +11,7 @@ caller left does not wait for one.
 
 import signal
 import subprocess
+import threading
 import time
 
 from conftest import NodeProcess
@@ -18,6 +19,7 @@ from conftest import venv_script
 import numpy as np
 from planner_helpers import InProcessPlanner
 from planner_helpers import make_request
+from planner_helpers import wait_for
 import pytest
 from stop_check import ANSWERED
 from stop_check import CALL_TIMEOUT_SEC
@@ -110,6 +112,37 @@ def test_the_stop_does_not_wait_once_no_caller_is_left(ros_client):
     started = time.monotonic()
     planner.close()
     assert time.monotonic() - started < REPLY_GRACE_SEC / 2
+
+
+def test_a_request_that_comes_while_the_participant_stays_is_answered(ros_client):
+    # The stop keeps the participant, and so the advertised service, for the last reply
+    # (doc/design.md section 16): a call that reaches it then is answered, not left to
+    # its caller's timeout.
+    from punctured_planner.ros.qos import CLIENT_QOS
+    from punctured_planner.ros.runtime import LINGER_LIMIT_SEC
+    from punctured_planner.ros.runtime import REPLY_GRACE_SEC
+    from punctured_planner_interfaces.srv import PlanSequence
+    planner = InProcessPlanner()
+    client = ros_client.node.create_client(PlanSequence, planner.name('plan_sequence'),
+                                           qos_profile=CLIENT_QOS)
+    closing = threading.Thread(target=planner.close)
+    try:
+        ros_client.wait_for_service(client)
+        assert ros_client.call(client, make_request()).error_code == PlanSequence.Response.NONE
+        started = time.monotonic()
+        closing.start()
+        # The threads have stopped: the participant stays for the caller still there.
+        wait_for(lambda: not planner.threads.stuck(), what='the spin threads to stop')
+        response = ros_client.call(client, make_request(), timeout_sec=REPLY_GRACE_SEC / 2)
+        assert response.error_code in (PlanSequence.Response.NONE,
+                                       PlanSequence.Response.NODE_STOPPING), response.message
+    finally:
+        ros_client.node.destroy_client(client)
+        if closing.ident is None:
+            planner.close()
+        closing.join(timeout=2 * LINGER_LIMIT_SEC)
+    assert not closing.is_alive()
+    assert time.monotonic() - started < LINGER_LIMIT_SEC + REPLY_GRACE_SEC
 
 
 def test_a_frozen_caller_gets_its_reply_as_soon_as_it_reads_again(ros_client, ros_env,

@@ -63,7 +63,8 @@ result request still on the wire;
 (3) the participant stays until ``REPLY_GRACE_SEC`` after the last reply
 written (a service's response or an action server's), so that the DDS writer
 can still resend it at its next heartbeat to a client that missed part of it,
-or until no client of the services that replied is left; (4) teardown. rclpy
+or until no client of the services that replied is left, answering what still
+reaches its services meanwhile (at most ``LINGER_LIMIT_SEC``); (4) teardown. rclpy
 offers no acknowledgement of a service reply, so the linger is a bounded time
 after the write, not an observed delivery.
 
@@ -124,8 +125,11 @@ STOP_PLANNING_SEC = 10.0
 # 565 KB) that its reader was not reading when it went out arrives only then
 # (doc/design.md section 16).
 REPLY_GRACE_SEC = 4.0
-# Seconds between two looks at the graph while the participant stays.
+# Seconds between two looks at the graph and the services while the participant stays.
 LINGER_POLL_SEC = 0.05
+# Seconds the participant stays at most, however many requests reach it meanwhile (each
+# answered, and its reply given REPLY_GRACE_SEC within this).
+LINGER_LIMIT_SEC = 2 * REPLY_GRACE_SEC
 # Seconds the first node's thread spins on after the goal in flight ended, for a
 # result request still on the wire.
 REQUEST_GRACE_SEC = 1.0
@@ -388,15 +392,27 @@ class ExecutorThreads:
 
         The wait ends sooner once no client of the services that replied is left
         (a one-shot caller such as ``ros2 service call`` has its reply and is gone),
-        unless an action server replied: its clients are not counted.
+        unless an action server replied: its clients are not counted. The services
+        stay advertised meanwhile, so a request that reaches one is answered as
+        the node answers past the stop (_answer_waiting) and has its grace too,
+        within LINGER_LIMIT_SEC in all: a caller that keeps calling cannot hold
+        the stop.
         """
+        started = time.monotonic()
+        self._answer_all()
         if self._last_reply is None:
             return 0.0
-        started = time.monotonic()
-        end = self._last_reply + REPLY_GRACE_SEC
-        while (remaining := end - time.monotonic()) > 0.0 and self._awaited():
+        limit = started + LINGER_LIMIT_SEC
+        while (remaining := min(self._last_reply + REPLY_GRACE_SEC, limit)
+               - time.monotonic()) > 0.0 and self._awaited():
             time.sleep(min(remaining, LINGER_POLL_SEC))
+            self._answer_all()
         return time.monotonic() - started
+
+    def _answer_all(self) -> None:
+        """Answer what reached any node's services since its thread stopped (_answer_waiting)."""
+        for node in self.nodes:
+            self._answer_waiting(node)
 
     def _awaited(self) -> bool:
         """Return whether a client may still be waiting for a reply written before the stop."""
