@@ -6,6 +6,7 @@ the ExecutorThreads ``main()`` runs it with; the test talks to it
 over real DDS from the ``ros_client`` fixture's own Context.
 """
 
+import copy
 import itertools
 import os
 import time
@@ -195,4 +196,8 @@ def faulty_plan(fault):
         message.tracking_tolerance = float('inf')
     elif fault == 'acceleration':
         message.max_acceleration = float('inf')
+    elif fault == 'frame':  # the paths share one Header: robot_1's a copy of its own
+        header = copy.deepcopy(message.paths[1].header)
+        header.frame_id = 'odom'
+        message.paths[1].header = header
     return message

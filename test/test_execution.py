@@ -500,6 +500,8 @@ def test_plan_message_round_trip_to_the_executor_reference():
      ('tracking_tolerance', None, None)),
     ('acceleration', 'plan 3: max_acceleration is inf, not a finite number >= 0',
      ('max_acceleration', None, None)),
+    ('frame', "plan 3: the path of robot_1 is in frame 'odom', that of robot_0 in 'map'",
+     ('paths', 'robot_1', None)),
 ])
 def test_a_plan_message_that_is_not_a_plan_is_refused_naming_the_fault(fault, words,
                                                                        culprits):
@@ -509,8 +511,9 @@ def test_a_plan_message_that_is_not_a_plan_is_refused_naming_the_fault(fault, wo
     Before, a name that is no ROS name crashed plan_executor when it subscribed to the
     robot's odometry, a NaN pose made a goal command NaN velocities forever, stamps going
     back ended a goal at once as executed, one path for two names an IndexError, one pose
-    ended a differential goal UNKNOWN, an infinite tolerance never slowed the clock and an
-    infinite acceleration gave NaN references.
+    ended a differential goal UNKNOWN, an infinite tolerance never slowed the clock, an
+    infinite acceleration gave NaN references and a path in another frame was run in the
+    first path's.
     """
     from planner_helpers import faulty_plan
     from punctured_planner.ros import conversions

@@ -545,6 +545,10 @@ def test_options_outside_the_supported_range_are_refused_naming_them(options, wo
         Workspace(options.pop('obstacles'), variant='discs', **options)
     assert refused.value.code == ErrorCode.INVALID_REQUEST
     assert words in str(refused.value)
+    named = set(options) & {'lane_spacing', 'min_spacing', 'required_clearance', 'robot_radius',
+                            'dimension'}
+    if named:  # the option at fault as data too
+        assert refused.value.option == named.pop()
 
 
 def test_the_ends_of_the_supported_lengths_are_accepted():

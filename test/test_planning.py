@@ -3,6 +3,7 @@
 import numpy as np
 from planner_helpers import make_request
 from planner_helpers import OBSTACLES
+from punctured_planner.core import ErrorCode
 from punctured_planner.ros import conversions
 from punctured_planner.ros.planning import PlanSequenceHandler
 from punctured_planner.ros.settings import PLANNER
@@ -254,12 +255,16 @@ def test_the_parameters_hint_says_how_to_change_obstacles_and_radii_together():
             handler.check_parameter_obstacles(settings, four, changed)
         assert 'obstacle_radius must be a scalar or one value per obstacle' in str(refused.value)
         assert ('set_parameters_atomically' in str(refused.value)) == hinted
+        assert refused.value.parameters == ('obstacle_radius',)
     walled = PLANNER.settings({'robot_radius': 0.2, 'obstacle_radius': [0.3],
                                'obstacles': three, 'workspace_bounds': [-5, 5, -0.5, 5]})
     with pytest.raises(ValueError) as refused:
         handler.check_parameter_obstacles(walled, ObstacleSet(
             conversions.obstacles_from_parameter(walled.obstacles)), {'obstacles'})
     assert 'OUTSIDE_WORKSPACE' in str(refused.value) and 'y_min' in str(refused.value)
+    # the culprits as data: the parameter, the obstacle, the core's refusal as the cause
+    assert (refused.value.parameters, refused.value.index) == (('obstacles',), 2)
+    assert refused.value.__cause__.code == ErrorCode.OUTSIDE_WORKSPACE
     assert 'together' not in str(refused.value)
 
 

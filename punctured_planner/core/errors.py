@@ -169,8 +169,9 @@ class PlanningError(ValueError):
     side), ``distance`` how far the body reaches beyond it (> 0) and ``leg``
     the plan's leg (None for an input outside the bounds); for a plan that
     leaves the bounds ``configuration`` is that leg's segment. ``option`` is the
-    Workspace option whose value does not fit the others (obstacle_radius whose
-    count is not the obstacles'), where that is the fault. ``message`` is
+    Workspace option at fault, where one is: a value refused (a length, the
+    dimension, the variant) or one that does not fit the others (obstacle_radius
+    whose count is not the obstacles'). ``message`` is
     the template (module docstring); ``args[0]`` and ``str()`` are worded with
     the core's :class:`Names`.
     """

@@ -1,7 +1,7 @@
 """
-The supported ranges: of coordinates, and of lengths (spacings, radii, the clearance).
+The supported values: finite, coordinates in range, lengths (spacings, radii, clearance).
 
-One place for both rules; every layer finds its offender here and words its own
+One place for these rules; every layer finds its offender here and words its own
 message (doc/design.md section 9).
 """
 
@@ -21,6 +21,14 @@ MAX_COORDINATE = 1e15
 # refinement's caps then came out wrong); above, sums of lengths overflow (min_spacing =
 # 1e200 gave NaN times).
 MIN_LENGTH = 1e-100
+
+
+def first_non_finite(values: np.ndarray) -> tuple[int, ...] | None:
+    """Return the index of the first non-finite entry (NaN, +-inf) of an array, or None."""
+    finite = np.isfinite(values)
+    if finite.all():  # the usual case: no search
+        return None
+    return tuple(int(i) for i in np.argwhere(~finite)[0])
 
 
 def first_out_of_range(values: np.ndarray) -> tuple[int, ...] | None:
@@ -64,4 +72,4 @@ def checked_length(value: object, name: str, zero: bool) -> float:
         return float(value)
     raise PlanningError(ErrorCode.INVALID_REQUEST,
                         f'{name} must be {length_range(zero)}, got '
-                        f'{literal(repr(value))}')
+                        f'{literal(repr(value))}', option=name)

@@ -13,7 +13,8 @@ import numpy.typing as npt
 from .discs import DiscLayout, PillarClearance
 from .errors import ErrorCode, literal, PlanningError
 from .frame import checked_frame, choose_frame, Frame
-from .limits import checked_length, first_out_of_range, length_range, lengths_in_range
+from .limits import checked_length, first_non_finite, first_out_of_range, length_range
+from .limits import lengths_in_range
 from .limits import MAX_COORDINATE
 from .sections import VARIANTS
 from .validation import real_array
@@ -63,7 +64,7 @@ class Workspace:
                                       or dimension < 2):
             raise PlanningError(ErrorCode.INVALID_REQUEST,
                                 f'dimension must be an integer >= 2 or None, got '
-                                f'{literal(repr(dimension))}')
+                                f'{literal(repr(dimension))}', option='dimension')
         obstacles = real_array(obstacles, 'the obstacle array')
         if obstacles.size == 0:
             if obstacles.ndim == 2 and obstacles.shape[1] > 0:
@@ -81,11 +82,11 @@ class Workspace:
             raise PlanningError(ErrorCode.INVALID_REQUEST,
                                 f'obstacles of shape {obstacles.shape}: the dimension d must '
                                 f'be at least 2')
-        bad = np.argwhere(~np.isfinite(obstacles))
-        if bad.size:
+        bad = first_non_finite(obstacles)
+        if bad is not None:
             raise PlanningError(ErrorCode.NON_FINITE_VALUE,
                                 '{obstacle} has a non-finite coordinate',
-                                obstacle=int(bad[0][0]), coordinate=int(bad[0][1]))
+                                obstacle=bad[0], coordinate=bad[1])
         far = first_out_of_range(obstacles)
         if far is not None:
             raise PlanningError(ErrorCode.INVALID_REQUEST,
@@ -148,7 +149,8 @@ class Workspace:
         """Raise INVALID_REQUEST for an unknown variant."""
         if variant not in VARIANTS:
             raise PlanningError(ErrorCode.INVALID_REQUEST,
-                                f'variant must be one of {VARIANTS}, got {literal(repr(variant))}')
+                                f'variant must be one of {VARIANTS}, got {literal(repr(variant))}',
+                                option='variant')
 
     @property
     def obstacle_count(self) -> int:

@@ -14,7 +14,7 @@ import numpy.typing as npt
 from scipy.spatial import cKDTree
 
 from .errors import compared, ErrorCode, literal, PlanningError
-from .limits import first_out_of_range, MAX_COORDINATE
+from .limits import first_non_finite, first_out_of_range, MAX_COORDINATE
 from .pairs import pair_difference_matrix, point_pairs, with_obstacles
 from .walls import first_outside
 
@@ -196,8 +196,9 @@ def validate_configurations(configurations: npt.ArrayLike, obstacles: np.ndarray
     a wall, or beyond it, is refused (OUTSIDE_WORKSPACE).
     """
     checked, all_finite = _as_array(configurations, obstacles.shape[1])
-    if not all_finite:
-        m, robot, axis = (int(v) for v in np.argwhere(~np.isfinite(checked))[0])
+    bad = None if all_finite else first_non_finite(checked)
+    if bad is not None:
+        m, robot, axis = bad
         raise PlanningError(ErrorCode.NON_FINITE_VALUE,
                             f'{{configuration}}, robot {robot}: coordinate {axis} is '
                             f'{checked[m, robot, axis]}', configuration=m, robots=[robot],

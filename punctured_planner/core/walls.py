@@ -18,7 +18,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .errors import axis_name, ErrorCode, PlanningError, Wall
-from .limits import first_out_of_range, MAX_COORDINATE
+from .limits import first_non_finite, first_out_of_range, MAX_COORDINATE
 
 
 @dataclass(frozen=True)
@@ -75,12 +75,11 @@ def checked_bounds(bounds: npt.ArrayLike | None, dimension: int) -> np.ndarray |
         raise PlanningError(ErrorCode.INVALID_REQUEST,
                             f'bounds must have shape (d, 2) = ({dimension}, 2), one '
                             f'[min, max] per axis; got shape {array.shape}')
-    bad = np.argwhere(~np.isfinite(array))
-    if bad.size:
-        wall = Wall(int(bad[0][0]), bool(bad[0][1]))
+    bad = first_non_finite(array)
+    if bad is not None:
         raise PlanningError(ErrorCode.INVALID_REQUEST,
-                            f'bounds must be finite; {{wall}} is {array[tuple(bad[0])]}',
-                            wall=wall)
+                            f'bounds must be finite; {{wall}} is {array[bad]}',
+                            wall=Wall(bad[0], bool(bad[1])))
     far = first_out_of_range(array)
     if far is not None:
         raise PlanningError(ErrorCode.INVALID_REQUEST,

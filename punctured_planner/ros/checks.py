@@ -34,6 +34,7 @@ from ..core import PlanningError
 from ..core import SCHEDULES
 from ..core.errors import axis_name
 from ..core.errors import literal
+from ..core.limits import first_non_finite
 
 # Largest |z - plane_z| accepted in planar mode (m).
 PLANE_TOLERANCE = 1e-9
@@ -276,7 +277,7 @@ def _check_counts(settings: PlannerSettings, gathered: Gathered) -> None:
 
 def _check_non_finite(positions: np.ndarray) -> None:
     """NON_FINITE_VALUE in the robots' coordinates."""
-    bad = conversions.first_non_finite(positions)
+    bad = first_non_finite(positions)
     if bad is not None:
         m, robot, axis = bad
         raise PlanningError(ErrorCode.NON_FINITE_VALUE, '{configuration}, robot %d: %s is %r'
@@ -286,7 +287,7 @@ def _check_non_finite(positions: np.ndarray) -> None:
 
 def check_obstacle_values(obstacles: ObstacleSet) -> None:
     """NON_FINITE_VALUE in the obstacles' coordinates."""
-    bad = conversions.first_non_finite(obstacles.points)
+    bad = first_non_finite(obstacles.points)
     if bad is not None:
         raise PlanningError(ErrorCode.NON_FINITE_VALUE, '{obstacle}: %s is %r'
                             % (axis_name(bad[1]), float(obstacles.points[bad])),

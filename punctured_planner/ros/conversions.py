@@ -64,6 +64,8 @@ from .settings import PlannerSettings
 from .snapshot import Outcome
 from .snapshot import RobotOdometry
 from .. import core
+from ..core.limits import first_non_finite
+from ..core.timing import tracking_tolerance
 from ..execution import Bodies
 from ..execution import Reference
 
@@ -139,15 +141,6 @@ def obstacles_from_pose_array(msg: PoseArray) -> np.ndarray:
 def stamp_to_ns(stamp: Time) -> int:
     """Return a builtin_interfaces/Time as integer nanoseconds."""
     return int(stamp.sec) * 1000000000 + int(stamp.nanosec)
-
-
-def first_non_finite(values: npt.ArrayLike) -> tuple[int, ...] | None:
-    """Return the index tuple of the first non-finite entry of an array, or None."""
-    finite = np.isfinite(values)
-    if finite.all():  # the usual case: no search
-        return None
-    bad = np.argwhere(~finite)
-    return tuple(int(i) for i in bad[0]) if bad.size else None
 
 
 def leading_coordinates(points: npt.ArrayLike, dimension: int) -> np.ndarray:
@@ -453,8 +446,8 @@ def plan_reference(msg: Plan) -> Reference:
 
     Raises InvalidPlan, naming the plan and the robot, unless the message is a
     plan: one path per robot, the robots' names unique ROS names (each names
-    its topics), every pose (position and orientation) finite, one clock (the
-    same stamps on every path, at least two, strictly increasing) and numbers
+    its topics), every pose (position and orientation) finite, one frame and one
+    clock (the same stamps on every path, at least two, strictly increasing) and numbers
     a plan can have (plan_numbers).
     """
     plan_id = int(msg.plan_id)
@@ -473,7 +466,13 @@ def plan_reference(msg: Plan) -> Reference:
         count = stamps[0].size if stamps else 0
         raise InvalidPlan(plan_id, 'paths', ' has %s per path, a motion at least 2'
                           % core.errors.counted(count, 'pose'))
-    for name, path in zip(msg.robot_names, arrays):
+    frame = msg.paths[0].header.frame_id
+    for name, message, path in zip(msg.robot_names, msg.paths, arrays):
+        if message.header.frame_id != frame:
+            raise InvalidPlan(plan_id, 'paths', ': the path of %s is in frame %r, that of %s '
+                              'in %r: one frame for all' % (name, message.header.frame_id,
+                                                            msg.robot_names[0], frame),
+                              robot=name)
         if not np.array_equal(path.stamps, stamps[0]):
             raise InvalidPlan(plan_id, 'paths', ': the path of %s does not have the stamps '
                               'of %s' % (name, msg.robot_names[0]), robot=name)
@@ -511,7 +510,7 @@ def plan_numbers(msg: Plan) -> None:
                               % (name, value, '>' if strict else '>='))
     if np.isnan(gap):
         raise InvalidPlan(int(msg.plan_id), 'min_gap', ': min_gap is not a number')
-    if not tolerance <= 0.5 * gap:
+    if not tolerance <= tracking_tolerance(gap, np.inf):
         raise InvalidPlan(int(msg.plan_id), 'tracking_tolerance',
                           ': tracking_tolerance %r is more than min_gap / 2 (min_gap %r)'
                           % (tolerance, gap))

@@ -22,6 +22,7 @@ import numpy as np
 
 from . import checks
 from . import conversions
+from .parameters import InvalidParameter
 from .settings import PlannerSettings
 from .snapshot import ObstacleSet
 from .snapshot import Outcome
@@ -148,9 +149,12 @@ class PlanSequenceHandler:
                     'obstacle_radius one value first'
                     if error.option == 'obstacle_radius'
                     and len(changed & {'obstacles', 'obstacle_radius'}) == 1 else '')
-            raise ValueError('%s with %s: %s%s' % (
-                error.code.name, obstacles.describe(),
-                error.describe(ObstacleNames(obstacles.name)), hint)) from None
+            # The core's PlanningError (code, obstacle, option) stays as the cause.
+            raise InvalidParameter(
+                error.option or 'obstacles',
+                '%s with %s: %s%s' % (error.code.name, obstacles.describe(),
+                                      error.describe(ObstacleNames(obstacles.name)), hint),
+                index=error.obstacle) from error
 
     def check_workspace(self, settings: PlannerSettings, obstacles: ObstacleSet) -> None:
         """
@@ -193,4 +197,4 @@ class PlanSequenceHandler:
         return Outcome(response=response, plan=the_plan, paths=paths,
                        names=conversions.robot_names(settings.robot_names, gathered.counts[0]),
                        start_ns=start_ns, max_speed=max_speed,
-                       max_acceleration=max_acceleration, dropped=checked.dropped)
+                       max_acceleration=max_acceleration)
