@@ -68,6 +68,10 @@ class Recorder:
         from std_msgs.msg import Float64
 
         from .ros.qos import LATCHED
+        from .ros.topics import CMD_VEL
+        from .ros.topics import ODOM
+        from .ros.topics import REFERENCE_POSE
+        from .ros.topics import robot_topic
         self.node = node
         self.executor = executor
         self.executor.add_node(self.node)
@@ -80,15 +84,17 @@ class Recorder:
             return lambda msg: self.messages.append(
                 Heard(topic, msg, self.node.get_clock().now().nanoseconds))
 
+        def heard(name: str, topic: str) -> Callable[[Any], None]:
+            return keep('/demo/' + robot_topic(name, topic))
+
         self.node.create_subscription(Plan, 'plan', keep(PLAN_TOPIC), LATCHED)
         for name in names:
-            self.node.create_subscription(PoseStamped, name + '/reference_pose',
-                                          keep('/demo/%s/reference_pose' % name), 50)
-            self.node.create_subscription(Odometry, name + '/odom',
-                                          self._odometry(name, keep('/demo/%s/odom' % name)),
-                                          50)
-            self.node.create_subscription(Twist, name + '/cmd_vel',
-                                          keep('/demo/%s/cmd_vel' % name), 50)
+            self.node.create_subscription(PoseStamped, robot_topic(name, REFERENCE_POSE),
+                                          heard(name, REFERENCE_POSE), 50)
+            self.node.create_subscription(Odometry, robot_topic(name, ODOM),
+                                          self._odometry(name, heard(name, ODOM)), 50)
+            self.node.create_subscription(Twist, robot_topic(name, CMD_VEL),
+                                          heard(name, CMD_VEL), 50)
         self.node.create_subscription(Float64, 'fleet_sim/min_gap',
                                       lambda msg: self.gap.append(cast(Float64, msg).data),
                                       LATCHED)

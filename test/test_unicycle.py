@@ -16,6 +16,7 @@ import numpy as np
 from punctured_planner.execution import Execution
 from punctured_planner.execution import ExecutionSettings
 from punctured_planner.execution import Reference
+from punctured_planner.execution import Step
 from punctured_planner.execution import unicycle
 from punctured_planner.sim import Fleet
 from punctured_planner.sim import FleetSettings
@@ -207,6 +208,27 @@ def test_a_robot_made_holonomic_faces_x_again_and_moves_as_commanded():
     fleet.command(0, [0.5, 0.0, 0.0], 0.0)
     fleet.step(0.0, 0.1)
     assert np.allclose(fleet.positions, [[0.05, 0.0, 0.0]])
+
+
+def test_commands_and_odometry_are_in_each_robots_body_frame():
+    """The executor's commands and the simulator's odometry: rotated into each robot's frame."""
+    step = Step(plan_time=0.0, rate=1.0, positions=np.zeros((2, 3)),
+                orientations=np.tile(IDENTITY, (2, 1)),
+                velocities=np.array([[1.0, 0.0, 0.0], [0.3, 0.4, 0.0]]), errors=np.zeros(2),
+                watched=np.zeros(2), finished=False, differential=np.array([False, True]),
+                forward=np.array([0.0, 0.5]), yaw_rates=np.array([0.0, 0.2]), allowed=1.0)
+    # a holonomic robot facing +y told +x goes to its right; a differential one forward only
+    commands = step.body_commands(quaternions([np.pi / 2, 1.0]))
+    assert np.allclose(commands, [[0.0, -1.0, 0.0], [0.5, 0.0, 0.0]])
+    # the simulator's orientations are its headings' (yaw_quaternions, yaws' inverse)
+    assert np.allclose(unicycle.yaw_quaternions(np.array([0.7, -2.0])), quaternions([0.7, -2.0]))
+    fleet = fleet_of(np.array([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0]]), [0.7, -2.0],
+                     speed_limit=1.0)
+    assert np.allclose(fleet.orientations, quaternions([0.7, -2.0]))
+    fleet.command(0, [0.5, 0.0, 0.0], 0.0)
+    fleet.step(0.0, 0.1)
+    assert fleet.forward[0] > 0.0
+    assert np.allclose(fleet.body_velocities, [[fleet.forward[0], 0.0, 0.0], [0.0, 0.0, 0.0]])
 
 
 def polyline_reference(points, speed):

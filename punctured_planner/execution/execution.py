@@ -38,6 +38,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from . import unicycle
 from .bodies import Bodies
@@ -168,6 +169,18 @@ class Step:
     # the rate the robots allow (their errors, stale odometry: 0), before the acceleration
     # limit's rise: what a hold is judged on (execution.hold.ClockHold)
     allowed: float
+
+    def body_commands(self, orientations: np.ndarray) -> np.ndarray:
+        """
+        Return the (k, 3) linear commands in each robot's body frame, from its (k, 4) pose.
+
+        A holonomic robot's velocity rotated into its frame; a differential robot's
+        (forward, 0, 0): never a sideways part. The yaw rates are yaw_rates.
+        """
+        commands = Rotation.from_quat(orientations).apply(self.velocities, inverse=True)
+        commands[self.differential] = 0.0
+        commands[self.differential, 0] = self.forward[self.differential]
+        return commands
 
 
 def behind(lags: np.ndarray, motion: np.ndarray) -> np.ndarray:

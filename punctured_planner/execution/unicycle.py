@@ -29,6 +29,7 @@ still, towards its next move, and after the plan's end, to its final heading.
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from ..core.timing import leg_at
 
@@ -93,6 +94,11 @@ def yaws(quaternions: np.ndarray) -> np.ndarray:
     """Return the (k,) yaw angles of (k, 4) quaternions (x, y, z, w)."""
     x, y, z, w = np.asarray(quaternions, dtype=float).T
     return np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+def yaw_quaternions(angles: np.ndarray) -> np.ndarray:
+    """Return the (k, 4) quaternions (x, y, z, w) of (k,) yaw angles about z: yaws' inverse."""
+    return Rotation.from_euler('z', np.asarray(angles, dtype=float).reshape(-1, 1)).as_quat()
 
 
 def headings(angles: np.ndarray) -> np.ndarray:

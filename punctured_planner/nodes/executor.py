@@ -43,6 +43,7 @@ still spins, until every result is out); ``before_teardown`` sends zero
 velocity once more before the node goes.
 """
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from dataclasses import field
 import functools
@@ -65,7 +66,6 @@ from rclpy.node import Node
 from rclpy.publisher import Publisher
 from rclpy.subscription import Subscription
 from rclpy.task import Future
-from scipy.spatial.transform import Rotation
 
 from ..execution import Execution
 from ..execution import Step
@@ -92,6 +92,10 @@ from ..ros.runtime import run_nodes
 from ..ros.settings import EXECUTOR
 from ..ros.settings import ExecutorSettings
 from ..ros.snapshot import RobotOdometry
+from ..ros.topics import CMD_VEL
+from ..ros.topics import ODOM
+from ..ros.topics import REFERENCE_POSE
+from ..ros.topics import robot_topic
 
 Result = ExecutePlan.Result
 # Seconds a goal waits for a plan it names that was not heard yet (msg_docs/topics.md).
@@ -208,15 +212,19 @@ class PlanExecutor(Node):
             if wait.plan_id in (0, plan_id):
                 wait.wake()
 
+    def _odometry_topics(self, names: Sequence[str]) -> str:
+        """Return the robots' odometry topics, resolved, for a message."""
+        return ', '.join(self.resolve_topic_name(robot_topic(name, ODOM)) for name in names)
+
     def _link(self, name: str) -> None:
         """Create the odometry subscription and command publishers of a robot (once)."""
         if name in self._links:
             return
         self._links[name] = RobotLink(
-            self.create_subscription(Odometry, name + '/odom',
+            self.create_subscription(Odometry, robot_topic(name, ODOM),
                                      functools.partial(self._on_odometry, name), STATE),
-            self.create_publisher(Twist, name + '/cmd_vel', COMMANDS),
-            self.create_publisher(PoseStamped, name + '/reference_pose', COMMANDS))
+            self.create_publisher(Twist, robot_topic(name, CMD_VEL), COMMANDS),
+            self.create_publisher(PoseStamped, robot_topic(name, REFERENCE_POSE), COMMANDS))
 
     def _on_odometry(self, name: str, msg: Odometry) -> None:
         """
@@ -438,8 +446,7 @@ class PlanExecutor(Node):
             if now - run.requested_ns > settings.discovery_timeout * 1e9:
                 self._finish(run, Result.UNKNOWN_ROBOTS, 'no odometry within %g s from %s '
                              '(topics %s)' % (settings.discovery_timeout, ', '.join(state.stale),
-                                              ', '.join(self.resolve_topic_name(n + '/odom')
-                                                        for n in state.stale)))
+                                              self._odometry_topics(state.stale)))
             return None
         far = off_start(plan.reference, state.positions, plan.tolerance)
         if far.robots.size:
@@ -479,8 +486,7 @@ class PlanExecutor(Node):
             self._end(run, Result.ODOMETRY_LOST, 'odometry of %s stale (older than %g s; '
                       'topics %s): %s; every robot was sent zero velocity'
                       % (', '.join(over.stale), self._settings.odom_timeout,
-                         ', '.join(self.resolve_topic_name(n + '/odom')
-                                   for n in over.stale), held_at))
+                         self._odometry_topics(over.stale), held_at))
             return True
         plan, limit = run.plan, run.plan.tolerance * self._settings.execution.hold_fraction
         waited = waited_for(step.watched, limit)
@@ -511,19 +517,14 @@ class PlanExecutor(Node):
         """
         plan = run.plan
         header = conversions.header(plan.frame_id, now_ns)
-        body = Rotation.from_quat(state.orientations).apply(step.velocities, inverse=True)
+        commands = step.body_commands(state.orientations)
         velocity_mode = run.mode == 'velocity'
         for i, name in enumerate(plan.names):
             link = self._links[name]
             link.reference.publish(conversions.pose_stamped(header, step.positions[i],
                                                             step.orientations[i]))
-            if not velocity_mode:
-                continue
-            if step.differential[i]:
-                link.cmd_vel.publish(conversions.twist((step.forward[i], 0.0, 0.0),
-                                                       step.yaw_rates[i]))
-            else:
-                link.cmd_vel.publish(conversions.twist(body[i]))
+            if velocity_mode:
+                link.cmd_vel.publish(conversions.twist(commands[i], step.yaw_rates[i]))
 
     def _stop_robots(self, run: Run) -> None:
         """Send zero velocity to every robot of the run (mode velocity, as it started)."""

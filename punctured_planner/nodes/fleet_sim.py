@@ -33,6 +33,9 @@ from ..ros.runtime import NodeGroup
 from ..ros.runtime import run_nodes
 from ..ros.settings import FLEET_SIM
 from ..ros.settings import FleetSimSettings
+from ..ros.topics import CMD_VEL
+from ..ros.topics import ODOM
+from ..ros.topics import robot_topic
 from ..sim import Fleet
 
 
@@ -52,9 +55,10 @@ class FleetSim(Node):
         self._odometry = []
         self._sideways_logged: set[int] = set()
         for i, name in enumerate(self._names):
-            self.create_subscription(Twist, name + '/cmd_vel',
+            self.create_subscription(Twist, robot_topic(name, CMD_VEL),
                                      functools.partial(self._on_command, i), COMMANDS)
-            self._odometry.append(self.create_publisher(Odometry, name + '/odom', COMMANDS))
+            self._odometry.append(
+                self.create_publisher(Odometry, robot_topic(name, ODOM), COMMANDS))
         self._states = self.create_publisher(PoseArray, 'robot_states', COMMANDS)
         self._gap = self.create_publisher(Float64, '~/min_gap', LATCHED)
         self._timer = self.create_timer(self._period, self._step)
@@ -105,12 +109,7 @@ class FleetSim(Node):
         header = conversions.header(settings.frame_id, now_ns)
         states = PoseArray(header=header)
         fleet = self._fleet
-        yaws = fleet.headings
-        orientations = np.c_[np.zeros((len(yaws), 2)), np.sin(yaws / 2), np.cos(yaws / 2)]
-        # the twist is in the body frame: a differential robot's is (forward, 0, 0), yaw rate
-        twists = np.where(fleet.differential[:, None],
-                          np.c_[fleet.forward, np.zeros((len(yaws), 2))],
-                          fleet.velocities)
+        orientations, twists = fleet.orientations, fleet.body_velocities
         for i, name in enumerate(self._names):
             odometry = conversions.odometry(header, name + '/base_link', fleet.positions[i],
                                             twists[i], orientations[i], fleet.yaw_rates[i])

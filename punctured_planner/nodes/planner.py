@@ -86,6 +86,9 @@ from ..ros.snapshot import RobotOdometry
 from ..ros.snapshot import RobotState
 from ..ros.snapshot import Snapshot
 from ..ros.snapshot import take_snapshot
+from ..ros.topics import ODOM
+from ..ros.topics import PLAN
+from ..ros.topics import robot_topic
 from ..ros.wording import ObstacleNames
 # rmw_fastrtps waits up to 100 ms for the client's response reader to be matched,
 # then drops the reply; rclpy reports that with this warning (doc/design.md section 15).
@@ -195,7 +198,8 @@ class PlannerNode(Node):
         for name in names:
             if name not in self._odometry_subscriptions:
                 self._odometry_subscriptions[name] = self.inputs.create_subscription(
-                    Odometry, name + '/odom', functools.partial(self._on_odometry, name), STATE)
+                    Odometry, robot_topic(name, ODOM), functools.partial(self._on_odometry, name),
+                    STATE)
 
     def _on_obstacles(self, msg: PoseArray) -> None:
         """Take a new obstacle set if it can be planned in; else warn and keep the old one."""
@@ -402,7 +406,7 @@ class PlannerNode(Node):
         for publisher, message in zip(publishers[:paths], messages[:paths]):
             publisher.publish(message.data)
         for name in stale:
-            self._publisher(name + '/plan', Path).publish(
+            self._publisher(robot_topic(name, PLAN), Path).publish(
                 conversions.empty_path(settings.frame_id, outcome.start_ns))
         for publisher, message in zip(publishers[paths:], messages[paths:]):
             publisher.publish(message.data)
@@ -412,7 +416,7 @@ class PlannerNode(Node):
         """After a failed publish, latch empty paths so no robot keeps a partial plan."""
         try:
             for name in names:
-                self._publisher(name + '/plan', Path).publish(
+                self._publisher(robot_topic(name, PLAN), Path).publish(
                     conversions.empty_path(settings.frame_id, self.get_clock().now().nanoseconds))
         except Exception as error:  # the reply is out already
             self.get_logger().error('could not retract the partial plan: %r' % error)

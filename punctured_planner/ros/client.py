@@ -80,10 +80,9 @@ def wait_for_result(executor: Executor, handle: ClientGoalHandle, watch: GoalWat
     ``timeout_sec`` passed.
     """
     future = handle.get_result_async()
-    gone = spin_until(executor,
-                      lambda: future.done() or watch.silent_for() > FEEDBACK_SILENCE_SEC,
-                      timeout_sec)
-    if gone and future.done():
+    spin_until(executor, lambda: future.done() or watch.silent_for() > FEEDBACK_SILENCE_SEC,
+               timeout_sec)
+    if future.done():
         return future.result().result
     return None
 

@@ -19,6 +19,8 @@ from .conversions import plan_message
 from .markers import plan_markers
 from .settings import PlannerSettings
 from .snapshot import Outcome
+from .topics import PLAN
+from .topics import robot_topic
 
 
 @dataclass(frozen=True)
@@ -46,7 +48,7 @@ def plan_messages(outcome: Outcome, settings: PlannerSettings) -> list[Publicati
     executor never sees a plan whose paths are not out).
     """
     planned = outcome.planned()
-    messages = [Publication('%s/plan' % name.strip('/'), Path, data)
+    messages = [Publication(robot_topic(name, PLAN), Path, data)
                 for name, data in zip(planned.names, planned.paths.serialized)]
     messages.append(Publication('plan_markers', MarkerArray, plan_markers(
         planned.plan, settings.frame_id, outcome.start_ns, settings.plane_z, planned.names,

@@ -13,6 +13,8 @@ import numpy as np
 
 from .cdr import Paths
 from .settings import PlannerSettings
+from .topics import ODOM
+from .topics import robot_topic
 from ..core import ErrorCode
 from ..core import Plan
 
@@ -25,6 +27,8 @@ def format_stamp(ns: int) -> str:
 
 # ObstacleSet.source of the obstacles parameter's set (else the topic's name).
 PARAMETER = 'parameter'
+# Why a snapshot has no robot state: the words before ')' or the robots' odometry topics.
+NO_STATE = 'no robot state received yet (topic robot_states'
 
 
 @dataclass(frozen=True, eq=False)
@@ -83,7 +87,7 @@ class Snapshot:
     settings: PlannerSettings
     obstacles: ObstacleSet
     state: RobotState | None = None
-    state_problem: str = 'no robot state received yet (topic robot_states)'
+    state_problem: str = NO_STATE + ')'
 
     def describe(self) -> str:
         """Return the log line of the snapshot."""
@@ -112,7 +116,6 @@ class Outcome:
     max_speed: float = 0.0
     max_acceleration: float = 0.0  # the stamps' acceleration limit (0: unlimited)
     exception: BaseException | None = None
-    dropped: list[int] | None = None  # request configurations that repeated the state
     plan_id: int = 0  # the id the node published the plan under (0: not published)
 
     @property
@@ -173,9 +176,9 @@ def take_snapshot(settings: PlannerSettings, obstacles: ObstacleSet,
     if candidates:
         return Snapshot(settings, obstacles,
                         max(candidates, key=lambda state: state.received_ns), '')
-    problem = 'no robot state received yet (topic robot_states'
+    problem = NO_STATE
     if names:
-        problem += ', or odometry from %s' % ', '.join(n + '/odom' for n in missing)
+        problem += ', or odometry from %s' % ', '.join(robot_topic(n, ODOM) for n in missing)
     return Snapshot(settings, obstacles, None, problem + ')')
 
 

@@ -36,6 +36,7 @@ from ..execution.execution import ExecutionSettings
 from ..execution.execution import saturate
 from ..execution.unicycle import headings
 from ..execution.unicycle import wrap
+from ..execution.unicycle import yaw_quaternions
 
 
 @dataclass(frozen=True)
@@ -120,6 +121,23 @@ class Fleet:
         self._ramped[holonomic] = 0.0
         self.accelerations = np.broadcast_to(
             np.asarray(settings.max_acceleration, dtype=float), k).copy()
+
+    @property
+    def orientations(self) -> np.ndarray:
+        """Return each robot's heading about z as (k, 4) quaternions (x, y, z, w)."""
+        return yaw_quaternions(self.headings)
+
+    @property
+    def body_velocities(self) -> np.ndarray:
+        """
+        Return the (k, 3) velocities in each robot's body frame, as its odometry's twist.
+
+        A differential robot's is (forward, 0, 0); a holonomic robot faces +x, so
+        its body frame is the world's.
+        """
+        forward = np.zeros_like(self.velocities)
+        forward[:, 0] = self.forward
+        return np.where(self.differential[:, None], forward, self.velocities)
 
     @property
     def robot_count(self) -> int:

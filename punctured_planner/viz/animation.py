@@ -15,9 +15,8 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle
 import numpy as np
-from PIL import Image
 
-from .canvas import robot_colours
+from .canvas import grab_frame, robot_colours, write_gif
 from .geometry import plane_view
 from .picture import plan_figure, plan_title
 from ..core import Plan
@@ -97,16 +96,6 @@ class _Movers:
             body.set_center(tuple(history[-1, robot]))
 
 
-def _palette_of(image, colours=96):
-    """Return a palette image with the colours of image: one palette for every frame."""
-    return image.convert('RGB').quantize(colors=colours, method=Image.Quantize.MEDIANCUT)
-
-
-def _grab(figure):
-    """Return the canvas as it is now, as an RGB Pillow image."""
-    return Image.fromarray(np.asarray(figure.canvas.buffer_rgba())[..., :3].copy())
-
-
 def _static_background(figure, dynamic):
     """Return the figure drawn without its dynamic artists: what every frame starts from."""
     figure.canvas.draw()
@@ -172,9 +161,6 @@ def render_animation(plan: Plan, path: str | os.PathLike[str], fps: float = 20,
         heading_text.set_text(caption(frame))
         for artist in dynamic:
             figure.draw_artist(artist)
-        frames.append(_grab(figure))
-    palette = _palette_of(frames[0])
-    frames = [image.quantize(palette=palette, dither=Image.Dither.NONE) for image in frames]
-    frames[0].save(path, format='GIF', save_all=True, append_images=frames[1:],
-                   duration=int(round(1000 / fps)), loop=0)
+        frames.append(grab_frame(figure))
+    write_gif(path, frames, fps)
     return path

@@ -1,17 +1,23 @@
 """
-Headless figures: a matplotlib Figure with an Agg canvas, never pyplot.
+Headless figures: a matplotlib Figure with an Agg canvas, never pyplot; GIFs of its frames.
 
 A Figure built directly with an Agg canvas attached needs no backend choice,
 touches no global pyplot state and can never open a window, so it renders on
 machines without a display and inside a node's worker threads.
 """
 
+import os
 from typing import Literal
 
 import matplotlib
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.layout_engine import LayoutEngine
+import numpy as np
+from PIL import Image
+
+# Colours of a GIF's one palette, taken from its first frame.
+GIF_COLOURS = 96
 
 # What Figure's layout argument takes.
 _Layout = Literal['constrained', 'compressed', 'tight'] | LayoutEngine | None
@@ -32,3 +38,25 @@ def robot_colours(count: int) -> list[tuple[float, float, float, float]]:
         return [palette(i) for i in range(count)]
     palette = matplotlib.colormaps['turbo']
     return [palette(i / (count - 1)) for i in range(count)]
+
+
+def grab_frame(figure: Figure) -> Image.Image:
+    """Return the figure's canvas as it is now, as an RGB Pillow image."""
+    canvas = figure.canvas
+    assert isinstance(canvas, FigureCanvasAgg)  # new_figure's
+    return Image.fromarray(np.asarray(canvas.buffer_rgba())[..., :3].copy())
+
+
+def write_gif(path: str | os.PathLike[str], frames: list[Image.Image], fps: float) -> None:
+    """
+    Write frames as a looping GIF at path, fps frames a second.
+
+    One palette for every frame (the first frame's colours, median cut) and no
+    dithering: the figures are flat colours, which dithering would speckle and
+    a palette per frame would make flicker.
+    """
+    palette = frames[0].convert('RGB').quantize(colors=GIF_COLOURS,
+                                                method=Image.Quantize.MEDIANCUT)
+    images = [image.quantize(palette=palette, dither=Image.Dither.NONE) for image in frames]
+    images[0].save(path, format='GIF', save_all=True, append_images=images[1:],
+                   duration=int(round(1000 / fps)), loop=0)

@@ -10,8 +10,7 @@ and the smallest gap so far. Headless (Agg, Pillow), like the other pictures.
 from matplotlib.patches import Circle
 import numpy as np
 
-from .animation import _grab, _palette_of
-from .canvas import new_figure, robot_colours
+from .canvas import grab_frame, new_figure, robot_colours, write_gif
 
 
 def render_motion(path: str, seconds: np.ndarray, positions: np.ndarray,
@@ -55,9 +54,6 @@ def render_motion(path: str, seconds: np.ndarray, positions: np.ndarray,
         heading.set_text('%s\nt = %.1f s, smallest gap so far %.3f m'
                          % (title, seconds[t], gaps[t]))
         figure.canvas.draw()
-        frames.append(_grab(figure))
-    palette = _palette_of(frames[0])
-    frames = [image.quantize(palette=palette) for image in frames]
-    frames[0].save(path, format='GIF', save_all=True, append_images=frames[1:],
-                   duration=int(round(1000 / fps)), loop=0)
+        frames.append(grab_frame(figure))
+    write_gif(path, frames, fps)
     return path
