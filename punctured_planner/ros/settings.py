@@ -88,8 +88,10 @@ class PlannerSettings:
         'and lanes, at least 2.1 robot radii.', low=1e-6, high=1e6).field()
     required_clearance: float = Spec(
         'required_clearance', 'double', 0.0,
-        'Refuse a plan whose certified minimum clearance is below this (m); 0 accepts '
-        'every collision-free plan.', low=0.0, high=1e6, check=lengths).field()
+        'Refuse a plan whose certified smallest gap is below this (m): the surface gap '
+        '(min_gap) where robots or obstacles have a radius, else the centre distance '
+        '(min_clearance); 0 accepts every collision-free plan.',
+        low=0.0, high=1e6, check=lengths).field()
     workspace_bounds: tuple = Spec(
         'workspace_bounds', 'double_array', [],
         'Walls of the workspace (m), in frame_id: [x_min, x_max, y_min, y_max] for '
