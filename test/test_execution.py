@@ -295,6 +295,22 @@ def test_a_stale_robot_keeps_its_last_heading():
     assert np.array_equal(state.orientations, np.tile(facing_y, (len(plan.names), 1)))
 
 
+def test_odometry_in_another_frame_names_the_robot_and_both_frames():
+    """fleet_state: an empty frame is the plan's; another one is a WrongFrame, as data."""
+    from planner_helpers import faulty_plan
+    from punctured_planner.ros import conversions
+    from punctured_planner.ros.goals import fleet_state
+    from punctured_planner.ros.goals import WrongFrame
+    from punctured_planner.ros.snapshot import RobotOdometry
+    plan = conversions.known_plan(faulty_plan('none'))
+    frames = {name: '' for name in plan.names}
+    for frame, expected in (('', None), ('odom', WrongFrame(plan.names[1], 'odom', 'map'))):
+        frames[plan.names[1]] = frame
+        odometry = {name: RobotOdometry(plan.reference.position(0.0)[i], IDENTITY, frames[name],
+                                        0, 0) for i, name in enumerate(plan.names)}
+        assert fleet_state(plan, odometry, 0, 0.5).wrong_frame == expected
+
+
 def demo_plan():
     """
     Return (Reference, Bodies, min gap) of the demo's plan: four discs, 1 m/s, 1 m/s^2.

@@ -412,9 +412,9 @@ class PlanExecutor(Node):
         now = self.get_clock().now().nanoseconds
         plan, settings = run.plan, self._settings
         state = fleet_state(plan, self._odometry, now, settings.odom_timeout)
-        if state.wrong_frame:
+        if state.wrong_frame is not None:
             self._stop_robots(run)
-            self._finish(run, Result.FRAME_MISMATCH, state.wrong_frame)
+            self._finish(run, Result.FRAME_MISMATCH, state.wrong_frame.describe())
             return
         execution = run.execution if run.execution is not None else self._start(run, state, now)
         if execution is None:

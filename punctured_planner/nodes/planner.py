@@ -64,20 +64,19 @@ from rclpy.subscription import Subscription
 from std_msgs.msg import UInt32
 from visualization_msgs.msg import MarkerArray
 
-from ..core import ErrorCode
 from ..core import PlanningError
 from ..core.errors import counted
 from ..ros import conversions
 from ..ros import publications
 from ..ros.parameters import NodeParameters
 from ..ros.planning import PlanSequenceHandler
+from ..ros.planning import refuse_stopping
 from ..ros.qos import LATCHED
 from ..ros.qos import SERVER_QOS
 from ..ros.qos import STATE
 from ..ros.runtime import NodeGroup
 from ..ros.runtime import past_planning_budget
 from ..ros.runtime import run_nodes
-from ..ros.runtime import STOP_PLANNING_SEC
 from ..ros.settings import PLANNER
 from ..ros.settings import PlannerSettings
 from ..ros.snapshot import ObstacleSet
@@ -262,23 +261,6 @@ class PlannerNode(Node):
         """Take the stop's start (NodeGroup.on_stop): past the budget, only replies go out."""
         self._stop_began = began
 
-    def _refuse_late(self, number: int, request: PlanSequence.Request,
-                     response: PlanSequence.Response) -> PlanSequence.Response:
-        """
-        Answer request #number unplanned: it was taken STOP_PLANNING_SEC into a stop.
-
-        It gets NODE_STOPPING at once, so that the stop still answers every caller
-        that reached the node before it within its timeout (doc/design.md section 16).
-        """
-        message = ('%s stopping: request #%d (%s) reached it before the '
-                   'stop signal but waited more than %.0f s into the stop, so it was not '
-                   'planned; send it again to a running node'
-                   % (self.get_name(), number,
-                      counted(len(request.configurations), 'configuration'),
-                      STOP_PLANNING_SEC))
-        self.get_logger().warning('plan_sequence #%d: %s' % (number, message))
-        return conversions.fill_error(response, ErrorCode.NODE_STOPPING, message)
-
     def _resume_collection(self) -> None:
         """Turn the cyclic collector back on if it was on when the call was taken."""
         if self._collecting:
@@ -290,7 +272,9 @@ class PlannerNode(Node):
         self._request_count += 1
         number = self._answering = self._request_count
         if past_planning_budget(self._stop_began):
-            return self._refuse_late(number, request, response)
+            refuse_stopping(response, self.get_name(), number, len(request.configurations))
+            self.get_logger().warning('plan_sequence #%d: %s' % (number, response.error_msg))
+            return response
         now_ns = self.get_clock().now().nanoseconds
         snapshot = self.snapshot()
         logger = self.get_logger()

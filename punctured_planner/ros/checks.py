@@ -24,6 +24,7 @@ from . import conversions
 from .settings import MAX_SAMPLES_PER_LEG
 from .settings import PlannerSettings
 from .snapshot import format_stamp
+from .snapshot import in_other_frame
 from .snapshot import ObstacleSet
 from .snapshot import RobotState
 from .snapshot import Snapshot
@@ -297,7 +298,7 @@ def check_obstacle_values(obstacles: ObstacleSet) -> None:
 def _check_frames(settings: PlannerSettings, frames: list[str]) -> None:
     """FRAME_MISMATCH: a configuration in a frame other than the planning frame."""
     for m, frame_id in enumerate(frames):
-        if frame_id and frame_id != settings.frame_id:
+        if in_other_frame(frame_id, settings.frame_id):
             raise PlanningError(ErrorCode.FRAME_MISMATCH, "{configuration} is in frame '%s', "
                                 "the planning frame is '%s'" % (literal(frame_id),
                                                                 literal(settings.frame_id)),
@@ -306,7 +307,7 @@ def _check_frames(settings: PlannerSettings, frames: list[str]) -> None:
 
 def check_obstacle_frame(settings: PlannerSettings, obstacles: ObstacleSet) -> None:
     """FRAME_MISMATCH: obstacles in a frame other than the planning frame."""
-    if obstacles.frame_id and obstacles.frame_id != settings.frame_id:
+    if in_other_frame(obstacles.frame_id, settings.frame_id):
         fail(ErrorCode.FRAME_MISMATCH, "the obstacles (from %s) are in frame '%s', the "
              "planning frame is '%s'" % (obstacles.origin, obstacles.frame_id,
                                          settings.frame_id))

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 from punctured_planner_interfaces.action import ExecutePlan
 
+from .snapshot import in_other_frame
 from .snapshot import RobotOdometry
 from ..execution import Bodies
 from ..execution import Reference
@@ -142,6 +143,20 @@ def _keep(history: OrderedDict, plan_id: int, value: object) -> None:
         history.popitem(last=False)
 
 
+@dataclass(frozen=True)
+class WrongFrame:
+    """A robot whose odometry is in a frame other than its plan's: the robot, both frames."""
+
+    robot: str
+    frame_id: str
+    plan_frame_id: str
+
+    def describe(self) -> str:
+        """Return the reason, naming the robot and both frames."""
+        return ('odometry of %s is in frame %r, the plan in %r'
+                % (self.robot, self.frame_id, self.plan_frame_id))
+
+
 @dataclass(frozen=True, eq=False)
 class FleetState:
     """
@@ -150,8 +165,8 @@ class FleetState:
     positions (k, 3) and orientations (k, 4) (a stale robot keeps the plan's
     start and the identity), the stale robots' names and (k,) mask, the (k,)
     ages of the odometry by arrival (s; 0 for a stale robot) and
-    ``wrong_frame``: why some odometry is in another frame than the plan's
-    ('' when none is).
+    ``wrong_frame``: the first robot whose odometry is in another frame than
+    the plan's (None when none is).
     """
 
     positions: np.ndarray
@@ -159,7 +174,7 @@ class FleetState:
     stale: tuple
     stale_mask: np.ndarray
     ages: np.ndarray
-    wrong_frame: str = ''
+    wrong_frame: WrongFrame | None = None
 
 
 def fleet_state(plan: KnownPlan, odometry: dict[str, RobotOdometry], now_ns: int,
@@ -169,7 +184,7 @@ def fleet_state(plan: KnownPlan, odometry: dict[str, RobotOdometry], now_ns: int
     positions = plan.reference.position(0.0).copy()
     orientations = np.tile([0.0, 0.0, 0.0, 1.0], (k, 1))
     stale = []
-    wrong_frame = ''
+    wrong_frame = None
     ages = np.zeros(k)
     for i, name in enumerate(plan.names):
         entry = odometry.get(name)
@@ -178,9 +193,8 @@ def fleet_state(plan: KnownPlan, odometry: dict[str, RobotOdometry], now_ns: int
             if entry is not None:  # its last heading: a stale robot is still commanded
                 orientations[i] = entry.orientation
             continue
-        if entry.frame_id and entry.frame_id != plan.frame_id:
-            wrong_frame = ('odometry of %s is in frame %r, the plan in %r'
-                           % (name, entry.frame_id, plan.frame_id))
+        if in_other_frame(entry.frame_id, plan.frame_id):
+            wrong_frame = WrongFrame(name, entry.frame_id, plan.frame_id)
             break
         positions[i] = entry.position
         orientations[i] = entry.orientation

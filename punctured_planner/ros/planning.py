@@ -23,6 +23,7 @@ import numpy as np
 from . import checks
 from . import conversions
 from .parameters import InvalidParameter
+from .runtime import STOP_PLANNING_SEC
 from .settings import PlannerSettings
 from .snapshot import ObstacleSet
 from .snapshot import Outcome
@@ -33,9 +34,26 @@ from .. import core
 from ..core import ErrorCode
 from ..core import PlanningError
 from ..core import Workspace
+from ..core.errors import counted
 
 # Workspaces kept (one per obstacle set and options): a few, for topics that alternate.
 WORKSPACE_CACHE_SIZE = 4
+
+
+def refuse_stopping(response: Any, node_name: str, number: int,
+                    configuration_count: int) -> None:
+    """
+    Fill response with NODE_STOPPING: request #number was taken STOP_PLANNING_SEC into a stop.
+
+    It is answered unplanned at once, so that the stop still answers every caller
+    that reached the node before it within its timeout (doc/design.md section 16).
+    """
+    conversions.fill_error(
+        response, ErrorCode.NODE_STOPPING,
+        '%s stopping: request #%d (%s) reached it before the stop signal but waited more '
+        'than %.0f s into the stop, so it was not planned; send it again to a running node'
+        % (node_name, number, counted(configuration_count, 'configuration'),
+           STOP_PLANNING_SEC))
 
 
 class PlanSequenceHandler:

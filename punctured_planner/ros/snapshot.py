@@ -27,6 +27,18 @@ def format_stamp(ns: int) -> str:
 
 # ObstacleSet.source of the obstacles parameter's set (else the topic's name).
 PARAMETER = 'parameter'
+
+
+def in_other_frame(frame_id: str, planning_frame: str) -> bool:
+    """
+    Return whether an input's frame_id names a frame other than the planning frame.
+
+    An empty frame_id is the planning frame: there is no TF lookup, so an input in
+    another frame is refused, never transformed.
+    """
+    return bool(frame_id) and frame_id != planning_frame
+
+
 # Why a snapshot has no robot state: the words before ')' or the robots' odometry topics.
 NO_STATE = 'no robot state received yet (topic robot_states'
 
@@ -167,7 +179,7 @@ def take_snapshot(settings: PlannerSettings, obstacles: ObstacleSet,
     if names and not missing:
         entries = [odometry[name] for name in names]
         frames = [e.frame_id for e in entries]
-        frame = next((f for f in frames if f and f != settings.frame_id), frames[0])
+        frame = next((f for f in frames if in_other_frame(f, settings.frame_id)), frames[0])
         candidates.append(RobotState(
             np.stack([e.position for e in entries]),
             np.stack([e.orientation for e in entries]), frame,

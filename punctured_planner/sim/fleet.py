@@ -72,6 +72,23 @@ class Contact:
     gap: float
 
 
+@dataclass(frozen=True)
+class Command:
+    """A robot's command as received: when it applies (after latency), linear and yaw rate."""
+
+    applies_at: float     # s
+    linear: np.ndarray    # (3,) body frame, m/s
+    yaw_rate: float       # rad/s
+
+
+@dataclass(frozen=True)
+class Commanded:
+    """The fleet's commands in force: (k, 3) linear velocities and (k,) yaw rates."""
+
+    linear: np.ndarray
+    yaw_rates: np.ndarray
+
+
 class Fleet:
     """k robots at centres (k, 3); commands in, positions and the true gap out."""
 
@@ -86,9 +103,8 @@ class Fleet:
         self._moves = np.zeros((k, 3))    # the last step's chords, differential robots
         self._ramped = np.zeros((k, 2))   # (forward, yaw rate) after the acceleration limits
         self._linear = np.zeros((k, 3))   # holonomic velocities after the acceleration limit
-        # (apply_time, linear velocity (3,), yaw rate)
-        self._pending: list[deque] = [deque() for _ in range(k)]
-        self._active = np.zeros((k, 4))
+        self._pending: list[deque[Command]] = [deque() for _ in range(k)]
+        self._active = Commanded(np.zeros((k, 3)), np.zeros(k))
         self._active_since = np.full(k, -np.inf)
         self._rng = np.random.default_rng(settings.seed)
         self.configure(settings)
@@ -153,24 +169,25 @@ class Fleet:
         angular z (a holonomic robot ignores it, a differential one uses only
         velocity[0] and it).
         """
-        self._pending[robot].append((now + self.latencies[robot],
-                                     np.append(np.asarray(velocity, dtype=float), yaw_rate)))
+        self._pending[robot].append(Command(now + self.latencies[robot],
+                                            np.asarray(velocity, dtype=float), float(yaw_rate)))
 
-    def _commanded(self, now: float) -> np.ndarray:
-        """Return the (k, 4) commands (linear, yaw rate) in force at now (0 if timed out)."""
+    def _commanded(self, now: float) -> Commanded:
+        """Return the commands in force at now (0 where the last one timed out)."""
         for robot, pending in enumerate(self._pending):
-            while pending and pending[0][0] <= now:
-                self._active_since[robot], self._active[robot] = pending.popleft()
-        timed_out = now - self._active_since > self.settings.command_timeout
-        commanded = self._active.copy()
-        commanded[timed_out] = 0.0
-        return commanded
+            while pending and pending[0].applies_at <= now:
+                command = pending.popleft()
+                self._active_since[robot] = command.applies_at
+                self._active.linear[robot] = command.linear
+                self._active.yaw_rates[robot] = command.yaw_rate
+        live = (now - self._active_since <= self.settings.command_timeout)
+        return Commanded(self._active.linear * live[:, None], self._active.yaw_rates * live)
 
-    def _unicycle_step(self, commanded: np.ndarray, dt: float) -> np.ndarray:
+    def _unicycle_step(self, commanded: Commanded, dt: float) -> np.ndarray:
         """Turn and drive the differential robots for dt; return their arcs' sagittas (k,)."""
         s = self.settings
-        wanted = np.c_[np.clip(commanded[:, 0], -s.speed_limit, s.speed_limit),
-                       np.clip(commanded[:, 3], -s.yaw_rate_limit, s.yaw_rate_limit)]
+        wanted = np.c_[np.clip(commanded.linear[:, 0], -s.speed_limit, s.speed_limit),
+                       np.clip(commanded.yaw_rates, -s.yaw_rate_limit, s.yaw_rate_limit)]
         limits = np.c_[self.accelerations, np.full(len(wanted), s.max_yaw_acceleration)] * dt
         change = wanted - self._ramped
         self._ramped = np.where(limits > 0, self._ramped + np.clip(change, -limits, limits),
@@ -199,7 +216,7 @@ class Fleet:
         """Move every robot for dt seconds from time now; return the new Contacts."""
         s = self.settings
         commanded = self._commanded(now)
-        linear = self._ramp(saturate(commanded[:, :3], s.speed_limit), dt)
+        linear = self._ramp(saturate(commanded.linear, s.speed_limit), dt)
         noise = 1.0 + s.velocity_noise * self._rng.standard_normal(linear.shape)
         holonomic = self.speed_factors[:, None] * linear * noise
         sagittas = np.zeros(self.robot_count)
