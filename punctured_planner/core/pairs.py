@@ -67,6 +67,31 @@ class PointPair:
         return cls('robots', int(first), int(second))
 
 
+def first_equal_pair(points: np.ndarray,
+                     groups: np.ndarray | None = None) -> tuple[int, int] | None:
+    """
+    Return indices a < b of two equal points (N, d) or values (N,), or None: sorting, not pairs.
+
+    With groups (N,) only points of one group count (one configuration's robots).
+    The pair is the first one in sorted order, so the same input names the same pair.
+    """
+    points = np.asarray(points)
+    if len(points) < 2:
+        return None
+    columns = points.reshape(len(points), -1)
+    keys = tuple(columns.T[::-1]) + (() if groups is None else (groups,))
+    order = np.lexsort(keys)
+    ordered = columns[order]
+    same = np.all(ordered[1:] == ordered[:-1], axis=1)
+    if groups is not None:
+        same &= groups[order][1:] == groups[order][:-1]
+    hits = np.flatnonzero(same)
+    if hits.size == 0:
+        return None
+    a, b = sorted((int(order[hits[0]]), int(order[hits[0] + 1])))
+    return a, b
+
+
 def with_obstacles(configurations: np.ndarray, obstacles: np.ndarray) -> np.ndarray:
     """Return (n, k + r, d): every configuration's robots followed by the fixed obstacles."""
     n, k, d = configurations.shape

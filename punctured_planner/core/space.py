@@ -16,19 +16,10 @@ from .frame import checked_frame, choose_frame, Frame
 from .limits import checked_length, first_non_finite, first_out_of_range, length_range
 from .limits import lengths_in_range
 from .limits import MAX_COORDINATE
+from .pairs import first_equal_pair
 from .sections import VARIANTS
 from .validation import real_array
 from .walls import checked_bounds, first_outside
-
-
-def _coincident_pair(values):
-    """Return indices (a, b), a < b, of two equal entries of a 1-D array, or None."""
-    order = np.argsort(values, kind='stable')
-    equal = np.flatnonzero(np.diff(values[order]) == 0)
-    if equal.size == 0:
-        return None
-    a, b = sorted((int(order[equal[0]]), int(order[equal[0] + 1])))
-    return a, b
 
 
 class Workspace:
@@ -106,7 +97,7 @@ class Workspace:
         self.frame = self._default_frame() if frame is None else checked_frame(frame,
                                                                                self.dimension)
         self.obstacle_projections = self.frame.project(obstacles)
-        same = _coincident_pair(self.obstacle_projections)
+        same = first_equal_pair(self.obstacle_projections)
         if same is not None:
             raise PlanningError(ErrorCode.OBSTACLES_DEGENERATE,
                                 '{obstacles} share one projection on '
@@ -119,16 +110,11 @@ class Workspace:
 
     def _reject_coincident_obstacles(self):
         """Raise OBSTACLES_DEGENERATE if two obstacles are the same point."""
-        obstacles = self.obstacles
-        if len(obstacles) < 2:
-            return
-        order = np.lexsort(obstacles.T[::-1])
-        same = np.flatnonzero(np.all(np.diff(obstacles[order], axis=0) == 0, axis=1))
-        if same.size:
-            a, b = sorted((int(order[same[0]]), int(order[same[0] + 1])))
+        same = first_equal_pair(self.obstacles)
+        if same is not None:
             raise PlanningError(ErrorCode.OBSTACLES_DEGENERATE,
-                                '{obstacles} are at the same point', obstacle=a,
-                                obstacles=(a, b))
+                                '{obstacles} are at the same point', obstacle=same[0],
+                                obstacles=same)
 
     def _reject_obstacles_outside(self):
         """Raise OUTSIDE_WORKSPACE for a pillar whose centre is closer than rho to a wall."""

@@ -9,13 +9,15 @@ message names the configuration (0-based m for C_{m+1}), the robots and the
 obstacle at fault.
 """
 
+from dataclasses import dataclass
+
 import numpy as np
 import numpy.typing as npt
 from scipy.spatial import cKDTree
 
 from .errors import compared, ErrorCode, literal, PlanningError
 from .limits import first_non_finite, first_out_of_range, MAX_COORDINATE
-from .pairs import pair_difference_matrix, point_pairs, with_obstacles
+from .pairs import first_equal_pair, pair_difference_matrix, point_pairs, with_obstacles
 from .walls import first_outside
 
 # Up to this many robots, coincidences are found by comparing every pair.
@@ -102,25 +104,32 @@ def _as_array(configurations, dimension):
     return np.stack(arrays), finite
 
 
+@dataclass(frozen=True)
+class Meeting:
+    """
+    Two bodies of C_m too close: robots first < second, or robot first and obstacle second.
+
+    distance is their centres' (0 where they are at one point).
+    """
+
+    configuration: int
+    first: int
+    second: int
+    distance: float = 0.0
+
+
 def _sorted_coincidence(configurations):
-    """Return (m, a, b) for two robots at one point in C_m, sorting the points; or None."""
+    """Return the Meeting of two robots at one point in some C_m, sorting the points; or None."""
     n, k, d = configurations.shape
-    flat = configurations.reshape(n * k, d)
-    config = np.repeat(np.arange(n), k)
-    order = np.lexsort(tuple(flat.T[::-1]) + (config,))
-    same = np.all(flat[order][1:] == flat[order][:-1], axis=1)
-    same &= config[order][1:] == config[order][:-1]
-    hits = np.flatnonzero(same)
-    if hits.size == 0:
+    pair = first_equal_pair(configurations.reshape(n * k, d), np.repeat(np.arange(n), k))
+    if pair is None:
         return None
-    first, second = order[hits[0]], order[hits[0] + 1]
-    a, b = sorted((int(first % k), int(second % k)))
-    return int(first // k), a, b
+    return Meeting(pair[0] // k, pair[0] % k, pair[1] % k)
 
 
 def _coincidences(configurations, obstacles):
     """
-    Return ((m, a, b) robots at one point or None, (m, robot, obstacle) or None).
+    Return (robots at one point, a robot on an obstacle's point): each a Meeting or None.
 
     Few robots: one product with the pair difference matrix gives every
     robot-robot and robot-obstacle difference; many: sort, and compare each
@@ -136,24 +145,25 @@ def _coincidences(configurations, obstacles):
         a, b = point_pairs(k, r)
         robot_pairs = k * (k - 1) // 2
         hits = np.argwhere(zero[:, :robot_pairs])
-        robots = (int(hits[0][0]), int(a[hits[0][1]]), int(b[hits[0][1]])) if hits.size else None
+        robots = (Meeting(int(hits[0][0]), int(a[hits[0][1]]), int(b[hits[0][1]]))
+                  if hits.size else None)
         hits = np.argwhere(zero[:, robot_pairs:])
         on = None
         if hits.size:
             m, pair = int(hits[0][0]), robot_pairs + int(hits[0][1])
-            on = (m, int(a[pair]), int(b[pair]) - k)
+            on = Meeting(m, int(a[pair]), int(b[pair]) - k)
         return robots, on
     if r:
         hits = np.argwhere(np.all(configurations[:, :, None, :] == obstacles[None, None], axis=3))
         if hits.size:
             m, robot, obstacle = (int(v) for v in hits[0])
-            return _sorted_coincidence(configurations), (m, robot, obstacle)
+            return _sorted_coincidence(configurations), Meeting(m, robot, obstacle)
     return _sorted_coincidence(configurations), None
 
 
 def _first_overlap(configurations, obstacles, robot_radius, obstacle_radii):
     """
-    Return ((m, a, b, distance) overlapping robot discs, (m, robot, obstacle, distance)).
+    Return (overlapping robot discs, a robot disc overlapping an obstacle's): Meetings.
 
     Either is None when there is none; the first configuration with one wins.
     Touching bodies (distance equal to the sum of the radii) do not overlap.
@@ -168,7 +178,7 @@ def _first_overlap(configurations, obstacles, robot_radius, obstacle_radii):
                 inside = np.flatnonzero(gaps < 2 * robot_radius)
                 if inside.size:
                     a, b = sorted(int(i) for i in pairs[inside[0]])
-                    robots = (m, a, b, float(gaps[inside[0]]))
+                    robots = Meeting(m, a, b, float(gaps[inside[0]]))
                     break
     on = None
     if len(obstacles) and (robot_radius > 0 or (obstacle_radii > 0).any()):
@@ -178,7 +188,7 @@ def _first_overlap(configurations, obstacles, robot_radius, obstacle_radii):
             hits = np.argwhere(distance < reach[None])
             if hits.size:
                 robot, obstacle = (int(v) for v in hits[0])
-                on = (m, robot, obstacle, float(distance[robot, obstacle]))
+                on = Meeting(m, robot, obstacle, float(distance[robot, obstacle]))
                 break
     return robots, on
 
@@ -205,12 +215,12 @@ def validate_configurations(configurations: npt.ArrayLike, obstacles: np.ndarray
                             coordinate=axis)
     coincident, on_obstacle = _coincidences(checked, obstacles)
     if coincident is not None:
-        m, a, b = coincident
+        m, a, b = coincident.configuration, coincident.first, coincident.second
         raise PlanningError(ErrorCode.ROBOTS_COINCIDE,
                             f'{{configuration}}: robots {a} and {b} are at the same point '
                             f'{checked[m, a].tolist()}', configuration=m, robots=[a, b])
     if on_obstacle is not None:
-        m, robot, obstacle = on_obstacle
+        m, robot, obstacle = on_obstacle.configuration, on_obstacle.first, on_obstacle.second
         raise PlanningError(ErrorCode.ROBOT_ON_OBSTACLE,
                             f'{{configuration}}: robot {robot} is on {{obstacle}}',
                             configuration=m, robots=[robot], obstacle=obstacle,
@@ -220,15 +230,15 @@ def validate_configurations(configurations: npt.ArrayLike, obstacles: np.ndarray
     overlap, on_obstacle = _first_overlap(checked, obstacles, robot_radius,
                                           obstacle_radii)
     if overlap is not None:
-        m, a, b, distance = overlap
-        apart, least = compared(distance, 2 * robot_radius)
+        m, a, b = overlap.configuration, overlap.first, overlap.second
+        apart, least = compared(overlap.distance, 2 * robot_radius)
         raise PlanningError(ErrorCode.ROBOTS_COINCIDE,
                             f'{{configuration}}: the discs of robots {a} and {b} overlap: '
                             f'centres {apart} apart, less than 2 robot_radius = {least}',
                             configuration=m, robots=[a, b])
     if on_obstacle is not None:
-        m, robot, obstacle, distance = on_obstacle
-        apart, least = compared(distance, robot_radius + obstacle_radii[obstacle])
+        m, robot, obstacle = on_obstacle.configuration, on_obstacle.first, on_obstacle.second
+        apart, least = compared(on_obstacle.distance, robot_radius + obstacle_radii[obstacle])
         raise PlanningError(ErrorCode.ROBOT_ON_OBSTACLE,
                             f'{{configuration}}: robot {robot} overlaps {{obstacle}}: '
                             f'centres {apart} apart, less than robot_radius + obstacle_radius '
