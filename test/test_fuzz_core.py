@@ -537,16 +537,17 @@ def test_subnormal_scale_certificate_is_exact(variant):
     ({'frame': ([0, 0], [1, 0])}, 'frame must be a Frame or (origin, e1, e2)'),
     ({'obstacles': [[1.0, 2.0], [3.0]]}, 'the obstacle array is not an array of real numbers'),
     ({'obstacles': [[1 + 1j, 0.0]]}, 'the obstacle array is not an array of real numbers'),
+    ({'variant': 'cubes'}, "variant must be one of ('paper', 'spread', 'discs'), got 'cubes'"),
 ])
 def test_options_outside_the_supported_range_are_refused_naming_them(options, words):
     """Lengths outside [1e-100, 1e15] (or 0 where allowed) and odd types: INVALID_REQUEST."""
     options = {'obstacles': [[0.0, 0.0], [1.0, 0.5]], **options}
     with pytest.raises(PlanningError) as refused:
-        Workspace(options.pop('obstacles'), variant='discs', **options)
+        Workspace(options.pop('obstacles'), **{'variant': 'discs', **options})
     assert refused.value.code == ErrorCode.INVALID_REQUEST
     assert words in str(refused.value)
     named = set(options) & {'lane_spacing', 'min_spacing', 'required_clearance', 'robot_radius',
-                            'dimension'}
+                            'dimension', 'variant'}
     if named:  # the option at fault as data too
         assert refused.value.option == named.pop()
 

@@ -86,12 +86,20 @@ def test_a_refused_value_carries_its_parameters_and_element(table, values, param
     assert (refused.value.parameters, refused.value.index) == (parameters, index)
 
 
-def test_a_count_that_fits_neither_all_nor_each_carries_its_counts():
-    with pytest.raises(WrongCount) as refused:
+@pytest.mark.parametrize('values, parameters, items', [
+    ({'max_acceleration': [1.0, 0.5, 2.0]}, ('max_acceleration', 'robot_names'), 'robots'),
+    ({'obstacles': [0.0] * 6, 'obstacle_radius': [1.0] * 3}, ('obstacle_radius', 'obstacles'),
+     'obstacles'),
+])
+def test_a_count_that_fits_neither_all_nor_each_carries_its_counts(values, parameters, items):
+    """An InvalidParameter naming both parameters; the WrongCount with its counts the cause."""
+    with pytest.raises(InvalidParameter) as refused:
         FLEET_SIM.settings({'robot_names': ['a', 'b'], 'initial_positions': [0.0] * 6,
-                            'max_acceleration': [1.0, 0.5, 2.0]})
-    assert (refused.value.name, refused.value.given, refused.value.expected,
-            refused.value.items) == ('max_acceleration', 3, 2, 'robots')
+                            **values})
+    assert refused.value.parameters == parameters
+    cause = refused.value.__cause__
+    assert isinstance(cause, WrongCount)
+    assert (cause.name, cause.given, cause.expected, cause.items) == (parameters[0], 3, 2, items)
 
 
 def test_workspace_bounds_become_the_cores_box_for_the_dimension():

@@ -255,16 +255,20 @@ def test_the_parameters_hint_says_how_to_change_obstacles_and_radii_together():
             handler.check_parameter_obstacles(settings, four, changed)
         assert 'obstacle_radius must be a scalar or one value per obstacle' in str(refused.value)
         assert ('set_parameters_atomically' in str(refused.value)) == hinted
-        assert refused.value.parameters == ('obstacle_radius',)
+        assert refused.value.parameters == tuple(sorted(changed)) + (
+            ('obstacle_radius',) if changed == {'obstacles'} else ())
     walled = PLANNER.settings({'robot_radius': 0.2, 'obstacle_radius': [0.3],
                                'obstacles': three, 'workspace_bounds': [-5, 5, -0.5, 5]})
     with pytest.raises(ValueError) as refused:
         handler.check_parameter_obstacles(walled, ObstacleSet(
             conversions.obstacles_from_parameter(walled.obstacles)), {'obstacles'})
     assert 'OUTSIDE_WORKSPACE' in str(refused.value) and 'y_min' in str(refused.value)
-    # the culprits as data: the parameter, the obstacle, the core's refusal as the cause
-    assert (refused.value.parameters, refused.value.index) == (('obstacles',), 2)
-    assert refused.value.__cause__.code == ErrorCode.OUTSIDE_WORKSPACE
+    # the culprits as data: the parameters (the changed one first), the core's refusal
+    # with its obstacle and wall as the cause
+    assert refused.value.parameters == ('obstacles', 'workspace_bounds')
+    cause = refused.value.__cause__
+    assert (cause.code, cause.obstacle) == (ErrorCode.OUTSIDE_WORKSPACE, 2)
+    assert cause.wall.name == 'y_min'
     assert 'together' not in str(refused.value)
 
 

@@ -229,6 +229,12 @@ def test_commands_and_odometry_are_in_each_robots_body_frame():
     fleet.step(0.0, 0.1)
     assert fleet.forward[0] > 0.0
     assert np.allclose(fleet.body_velocities, [[fleet.forward[0], 0.0, 0.0], [0.0, 0.0, 0.0]])
+    # a holonomic robot faces +x: its body frame is the world's, its twist its velocity
+    holonomic = Fleet(np.zeros((1, 3)), FleetSettings(speed_limit=1.0))
+    holonomic.command(0, [0.3, -0.4, 0.0], 0.0)
+    holonomic.step(0.0, 0.1)
+    assert np.allclose(holonomic.body_velocities, [[0.3, -0.4, 0.0]])
+    assert np.allclose(holonomic.orientations, [IDENTITY])
 
 
 def polyline_reference(points, speed):

@@ -172,7 +172,7 @@ class Step:
 
     def body_commands(self, orientations: np.ndarray) -> np.ndarray:
         """
-        Return the (k, 3) linear commands in each robot's body frame, from its (k, 4) pose.
+        Return the (k, 3) linear commands in each robot's body frame, from (k, 4) orientations.
 
         A holonomic robot's velocity rotated into its frame; a differential robot's
         (forward, 0, 0): never a sideways part. The yaw rates are yaw_rates.

@@ -75,8 +75,8 @@ from ..ros.qos import LATCHED
 from ..ros.qos import SERVER_QOS
 from ..ros.qos import STATE
 from ..ros.runtime import NodeGroup
-from ..ros.runtime import past_planning_budget
 from ..ros.runtime import run_nodes
+from ..ros.runtime import Stop
 from ..ros.settings import PLANNER
 from ..ros.settings import PlannerSettings
 from ..ros.snapshot import ObstacleSet
@@ -146,7 +146,7 @@ class PlannerNode(Node):
         self._send = self._service.send_response
         self._service.send_response = self._send_response  # type: ignore[method-assign]
         self._answering = 0  # the number of the request whose reply is being sent
-        self._stop_began: float | None = None  # time.monotonic() of the stop signal
+        self._stop: Stop | None = None  # the stop under way (NodeGroup.on_stop)
         self._collecting = True  # whether the cyclic collector ran when it was taken
         self._after_reply: AfterReply | None = None  # what to publish once it is sent
         s = self._settings
@@ -257,9 +257,9 @@ class PlannerNode(Node):
             self._resume_collection()
             raise
 
-    def note_stop(self, began: float) -> None:
-        """Take the stop's start (NodeGroup.on_stop): past the budget, only replies go out."""
-        self._stop_began = began
+    def note_stop(self, stop: Stop) -> None:
+        """Take the stop under way (NodeGroup.on_stop): once its planning is over, replies only."""
+        self._stop = stop
 
     def _resume_collection(self) -> None:
         """Turn the cyclic collector back on if it was on when the call was taken."""
@@ -271,8 +271,9 @@ class PlannerNode(Node):
         """Plan one request against a snapshot; keep what to log and publish after the reply."""
         self._request_count += 1
         number = self._answering = self._request_count
-        if past_planning_budget(self._stop_began):
-            refuse_stopping(response, self.get_name(), number, len(request.configurations))
+        if self._stop is not None and self._stop.planning_over():
+            refuse_stopping(response, self.get_name(), number, len(request.configurations),
+                            time.monotonic() - self._stop.began)
             self.get_logger().warning('plan_sequence #%d: %s' % (number, response.error_msg))
             return response
         now_ns = self.get_clock().now().nanoseconds
@@ -328,13 +329,13 @@ class PlannerNode(Node):
             after, self._after_reply = self._after_reply, None
             if after is not None:
                 self._log_outcome(after)
-                if after.outcome.ok and past_planning_budget(self._stop_began):
+                if after.outcome.ok and self._stop is not None and self._stop.planning_over():
                     # Publishing the largest plan took 10 s more: the stop must end, and
                     # the caller has its plan in the reply.
                     self.get_logger().warning(
                         'plan_sequence #%d: plan %d answered %.0f s into the stop: not '
                         'published' % (after.number, after.outcome.plan_id,
-                                       time.monotonic() - (self._stop_began or 0.0)))
+                                       time.monotonic() - self._stop.began))
                 elif after.outcome.ok:
                     self._publish_after_reply(after)
 

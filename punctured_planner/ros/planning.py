@@ -23,7 +23,6 @@ import numpy as np
 from . import checks
 from . import conversions
 from .parameters import InvalidParameter
-from .runtime import STOP_PLANNING_SEC
 from .settings import PlannerSettings
 from .snapshot import ObstacleSet
 from .snapshot import Outcome
@@ -40,20 +39,20 @@ from ..core.errors import counted
 WORKSPACE_CACHE_SIZE = 4
 
 
-def refuse_stopping(response: Any, node_name: str, number: int,
-                    configuration_count: int) -> None:
+def refuse_stopping(response: Any, node_name: str, number: int, configuration_count: int,
+                    into_stop: float) -> None:
     """
-    Fill response with NODE_STOPPING: request #number was taken STOP_PLANNING_SEC into a stop.
+    Fill response with NODE_STOPPING: request #number was taken into_stop s into a stop.
 
-    It is answered unplanned at once, so that the stop still answers every caller
-    that reached the node before it within its timeout (doc/design.md section 16).
+    Past the stop's planning budget, or while only its replies go out (the
+    linger), a request is answered unplanned at once, so that the stop still
+    answers every caller within its timeout (doc/design.md section 16).
     """
     conversions.fill_error(
         response, ErrorCode.NODE_STOPPING,
-        '%s stopping: request #%d (%s) reached it before the stop signal but waited more '
-        'than %.0f s into the stop, so it was not planned; send it again to a running node'
-        % (node_name, number, counted(configuration_count, 'configuration'),
-           STOP_PLANNING_SEC))
+        '%s stopping: request #%d (%s) was taken %.1f s after the stop signal, when the '
+        'node no longer plans; send it again to a running node'
+        % (node_name, number, counted(configuration_count, 'configuration'), into_stop))
 
 
 class PlanSequenceHandler:
@@ -167,12 +166,15 @@ class PlanSequenceHandler:
                     'obstacle_radius one value first'
                     if error.option == 'obstacle_radius'
                     and len(changed & {'obstacles', 'obstacle_radius'}) == 1 else '')
-            # The core's PlanningError (code, obstacle, option) stays as the cause.
+            # The parameters involved, those that changed first; the core's PlanningError
+            # (code, obstacle, wall, option) stays as the cause.
+            involved = {'obstacles', error.option or 'obstacles',
+                        'workspace_bounds' if error.wall is not None else 'obstacles'}
             raise InvalidParameter(
-                error.option or 'obstacles',
+                tuple(sorted(involved & changed) + sorted(involved - changed)),
                 '%s with %s: %s%s' % (error.code.name, obstacles.describe(),
-                                      error.describe(ObstacleNames(obstacles.name)), hint),
-                index=error.obstacle) from error
+                                      error.describe(ObstacleNames(obstacles.name)), hint)
+            ) from error
 
     def check_workspace(self, settings: PlannerSettings, obstacles: ObstacleSet) -> None:
         """

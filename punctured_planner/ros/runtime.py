@@ -115,7 +115,7 @@ STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 STOP_TIMEOUT_SEC = 60.0
 # Seconds after the stop signal within which a node still does all its work: a request
 # that waits is planned (later, refused at once), an answered plan published (later, only
-# the reply goes out): past_planning_budget, the node told by NodeGroup.on_stop. Five such
+# the reply goes out): Stop.planning_over, the node told by NodeGroup.on_stop. Five such
 # requests waiting made the stop overrun 30 s, exit 1 and lose three replies.
 STOP_PLANNING_SEC = 10.0
 # Seconds the participant stays after the last reply it wrote (step 3 of the stop),
@@ -212,21 +212,33 @@ class NodeGroup:
     returns a Future (or None) that the thread spins on for, such as a goal's
     result going out. ``before_teardown`` runs once the executors stopped and
     before any node is destroyed: publishers still work, no callback runs any more.
-    ``on_stop(began)`` runs in the signal's thread as the stop begins, with its
-    time.monotonic(): a node may then cut short what only matters while it runs
-    (past_planning_budget), in the callback in flight and in those of the requests
+    ``on_stop(stop)`` runs in the signal's thread as the stop begins, with its
+    :class:`Stop`: a node may then cut short what only matters while it runs
+    (Stop.planning_over), in the callback in flight and in those of the requests
     answered after it (the planner refuses them, NODE_STOPPING).
     """
 
     nodes: Sequence[Node]
     before_stop: Optional[Callable[[], Optional[Future]]] = None
     before_teardown: Optional[Callable[[], None]] = None
-    on_stop: Optional[Callable[[float], None]] = None
+    on_stop: Optional[Callable[['Stop'], None]] = None
 
 
-def past_planning_budget(began: Optional[float]) -> bool:
-    """Return whether a stop that began at ``began`` (time.monotonic()) is past its budget."""
-    return began is not None and time.monotonic() - began > STOP_PLANNING_SEC
+@dataclass
+class Stop:
+    """
+    A stop under way: when the signal came (time.monotonic()) and whether it only lingers now.
+
+    While lingering (step 3) nothing spins and no watchdog runs: a request
+    answered then gets only a quick reply.
+    """
+
+    began: float
+    lingering: bool = False
+
+    def planning_over(self) -> bool:
+        """Return whether only replies go out now: STOP_PLANNING_SEC in, or lingering."""
+        return self.lingering or time.monotonic() - self.began > STOP_PLANNING_SEC
 
 
 class ExecutorThreads:
@@ -242,7 +254,7 @@ class ExecutorThreads:
     def __init__(self, nodes: Sequence[Node], context: Optional[Context] = None,
                  on_failure: Optional[Callable[[], None]] = None,
                  before_stop: Optional[Callable[[], Optional[Future]]] = None,
-                 on_stop: Optional[Callable[[float], None]] = None):
+                 on_stop: Optional[Callable[[Stop], None]] = None):
         """Make one executor per node (in ``context``); nothing spins yet."""
         self.nodes: List[Node] = list(nodes)
         self.failure: Optional[BaseException] = None
@@ -250,7 +262,7 @@ class ExecutorThreads:
         self._before_stop = before_stop
         self._on_stop = on_stop
         self._stopping = threading.Event()
-        self._stop_began: Optional[float] = None  # time.monotonic() of the stop signal
+        self._stop: Optional[Stop] = None
         self._last_reply: Optional[float] = None  # time.monotonic() after the last reply
         # Who the linger waits for: the services that replied (name -> their node), and
         # whether an action server replied (its clients are not counted: it waits the
@@ -315,14 +327,15 @@ class ExecutorThreads:
 
     def _answer_waiting(self, node: Node) -> None:
         """
-        Answer the requests that reached the node's services before the stop (step 2).
+        Answer the requests that reached the node's services and were not taken yet.
 
         A request the executor had not taken yet when the signal came is in flight
         for its client too: it is taken and answered here, in this thread, as the
-        executor would (at most the server's queue depth per service). A node
-        past the stop's planning budget answers them quickly (NodeGroup.on_stop),
-        so that many large requests cannot hold the stop past STOP_TIMEOUT_SEC
-        and every one is answered.
+        executor would (at most the server's queue depth per service); so is one
+        that comes while the participant lingers. A node past the stop's planning
+        budget, or lingering, answers them quickly (NodeGroup.on_stop, Stop), so
+        that many large requests cannot hold the stop past STOP_TIMEOUT_SEC and
+        every one is answered.
         """
         for service in node.services:
             srv_type: Any = service.srv_type  # a generated type: Request, Response
@@ -365,10 +378,10 @@ class ExecutorThreads:
         Return False (and shut nothing down) if a thread is still running after
         ``timeout_sec``; :meth:`stuck` names its node.
         """
-        if self._stop_began is None:
-            self._stop_began = time.monotonic()
+        if self._stop is None:
+            self._stop = Stop(time.monotonic())
             if self._on_stop is not None:
-                self._on_stop(self._stop_began)
+                self._on_stop(self._stop)
         self._stopping.set()
         for executor in self._executors:
             executor.wake()
@@ -393,12 +406,14 @@ class ExecutorThreads:
         The wait ends sooner once no client of the services that replied is left
         (a one-shot caller such as ``ros2 service call`` has its reply and is gone),
         unless an action server replied: its clients are not counted. The services
-        stay advertised meanwhile, so a request that reaches one is answered as
-        the node answers past the stop (_answer_waiting) and has its grace too,
-        within LINGER_LIMIT_SEC in all: a caller that keeps calling cannot hold
-        the stop.
+        stay advertised meanwhile, so a request that reaches one is answered
+        (_answer_waiting) quickly, the stop lingering (Stop.planning_over), and
+        its reply has its grace too, within LINGER_LIMIT_SEC in all: a caller
+        that keeps calling cannot hold the stop.
         """
         started = time.monotonic()
+        if self._stop is not None:
+            self._stop.lingering = True
         self._answer_all()
         if self._last_reply is None:
             return 0.0
@@ -410,9 +425,20 @@ class ExecutorThreads:
         return time.monotonic() - started
 
     def _answer_all(self) -> None:
-        """Answer what reached any node's services since its thread stopped (_answer_waiting)."""
+        """
+        Answer what reached any node's services since its thread stopped (_answer_waiting).
+
+        A callback that raises is logged and kept in :attr:`failure`, as in a
+        spin thread, and the stop goes on: every other node is still answered and
+        torn down.
+        """
         for node in self.nodes:
-            self._answer_waiting(node)
+            try:
+                self._answer_waiting(node)
+            except Exception as error:  # noqa: B902 - logged; the exit code says it
+                self.failure = self.failure or error
+                node.get_logger().error('callback raised while stopping:\n' + ''.join(
+                    traceback.format_exception(error)))
 
     def _awaited(self) -> bool:
         """Return whether a client may still be waiting for a reply written before the stop."""

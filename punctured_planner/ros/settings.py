@@ -35,6 +35,7 @@ from ..execution import DRIVES
 from ..execution import ExecutionSettings
 from ..execution.execution import differential_mask
 from ..execution.execution import one_or_each
+from ..execution.execution import WrongCount
 from ..sim import FleetSettings
 
 # The variant parameter's default: 'discs' with a robot radius, else 'spread'.
@@ -432,15 +433,20 @@ def _fleet_counts(settings: FleetSimSettings) -> None:
         if values and len(values) != count:
             raise InvalidParameter((name, 'robot_names'), '%s has %d values for %d robots'
                                    % (name, len(values), count))
-    differential_mask(settings.drive, count)
-    one_or_each('max_acceleration', settings.max_acceleration, count)
+    try:
+        differential_mask(settings.drive, count)
+        one_or_each('max_acceleration', settings.max_acceleration, count)
+        one_or_each('obstacle_radius', settings.obstacle_radius, len(settings.obstacles) // 3,
+                    'obstacles')
+    except WrongCount as error:  # the setting, and the parameter it must fit
+        raise InvalidParameter(
+            (error.name, 'obstacles' if error.items == 'obstacles' else 'robot_names'),
+            str(error)) from error
     unknown = [name for name in settings.muted_robots if name not in settings.robot_names]
     if unknown:
         raise InvalidParameter(('muted_robots', 'robot_names'),
                                'muted_robots names %s, not among robot_names'
                                % ', '.join(unknown), index=settings.muted_robots.index(unknown[0]))
-    one_or_each('obstacle_radius', settings.obstacle_radius, len(settings.obstacles) // 3,
-                'obstacles')
 
 
 FLEET_SIM = Table('fleet_sim', FleetSimSettings, checks=(_fleet_counts,))

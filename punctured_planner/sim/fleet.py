@@ -170,7 +170,7 @@ class Fleet:
         velocity[0] and it).
         """
         self._pending[robot].append(Command(now + self.latencies[robot],
-                                            np.asarray(velocity, dtype=float), float(yaw_rate)))
+                                            np.array(velocity, dtype=float), float(yaw_rate)))
 
     def _commanded(self, now: float) -> Commanded:
         """Return the commands in force at now (0 where the last one timed out)."""
@@ -180,8 +180,9 @@ class Fleet:
                 self._active_since[robot] = command.applies_at
                 self._active.linear[robot] = command.linear
                 self._active.yaw_rates[robot] = command.yaw_rate
-        live = (now - self._active_since <= self.settings.command_timeout)
-        return Commanded(self._active.linear * live[:, None], self._active.yaw_rates * live)
+        timed_out = now - self._active_since > self.settings.command_timeout
+        return Commanded(np.where(timed_out[:, None], 0.0, self._active.linear),
+                         np.where(timed_out, 0.0, self._active.yaw_rates))
 
     def _unicycle_step(self, commanded: Commanded, dt: float) -> np.ndarray:
         """Turn and drive the differential robots for dt; return their arcs' sagittas (k,)."""
