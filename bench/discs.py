@@ -26,6 +26,7 @@ import peers
 from punctured_planner.core import plan, PlanningError, Workspace
 from punctured_planner.core.certificate import certify
 from punctured_planner.core.discs import MARGIN
+from punctured_planner.core.pairs import point_radii
 
 RADIUS = 0.25
 COVERAGE = 0.06
@@ -161,7 +162,7 @@ def run_rrt(fleet, budget):
     solved, seconds, raw, _, _ = peers._chain(query, planner, 'RRTConnect', budget, None)
     if not solved:
         return Result(RRT, fleet, -np.inf, np.nan, seconds)
-    radii = np.concatenate([np.full(fleet.k, RADIUS), fleet.radii])
+    radii = point_radii(fleet.k, RADIUS, fleet.radii)
     certificate = certify(np.linspace(0, 1, len(raw)), raw, fleet.pillars, radii)
     return Result(RRT, fleet, certificate.distance,
                   peers.length_ratio(raw, fleet.configurations), seconds,

@@ -32,6 +32,7 @@ import time
 
 import numpy as np
 from punctured_planner.ros.client import spin_until
+from punctured_planner.ros.conversions import duration_to_seconds
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 RESULTS_MD = os.path.join(HERE, 'execution.md')
@@ -312,8 +313,7 @@ def dds_run(the_plan, slow, late, shared_clock, tag, drive='holonomic'):
         # the largest error while the clock ran: the last feedback before the plan's end
         running = [f for _, f in feedback if f.plan_time < f.plan_duration]
         figures = {'code': result.error_code, 'message': result.error_msg,
-                   'executed': result.executed_duration.sec
-                   + result.executed_duration.nanosec * 1e-9, 'wall': wall,
+                   'executed': duration_to_seconds(result.executed_duration), 'wall': wall,
                    'error': max(result.max_tracking_errors), 'gap': graph.gap[-1],
                    'worst': int(np.argmax(result.max_tracking_errors)),
                    'running': max(running[-1].max_tracking_errors) if running else 0.0,

@@ -32,6 +32,7 @@ import peers
 
 from punctured_planner.core import plan, PlanningError, Workspace
 from punctured_planner.core.certificate import certify
+from punctured_planner.core.pairs import point_radii
 
 RADIUS, PILLAR = 0.2, 0.15
 COVERAGE = 0.06
@@ -170,7 +171,7 @@ def run_rrt(fleet, budget, simplify_budget):
     checking = planner.solve_checker_seconds + planner.simplify_checker_seconds
     if not solved:
         return Result(RRT, fleet, False, seconds=total, checker_seconds=checking)
-    radii = np.concatenate([np.full(fleet.k, RADIUS), np.full(len(fleet.pillars), PILLAR)])
+    radii = point_radii(fleet.k, RADIUS, np.full(len(fleet.pillars), PILLAR))
     gap = certify(np.linspace(0, 1, len(short)), short, fleet.pillars, radii).distance
     return Result(RRT, fleet, True, peers.length_ratio(short, fleet.configurations),
                   excursion(short, fleet), gap, 0.0, total, checking)

@@ -37,6 +37,7 @@ import time
 from node_session import planner_session
 import numpy as np
 from punctured_planner.ros.client import call_service
+from punctured_planner.ros.conversions import duration_to_seconds
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
                                 'test'))
@@ -142,7 +143,7 @@ def measure(executor, client, echo, published, k, n, calls, seed=1):
         seconds, response = timed_call(executor, client, request)
         trips.append(seconds)
         wait_published(executor, published, response.plan_id)
-        planning.append(response.planning_time.sec + response.planning_time.nanosec * 1e-9)
+        planning.append(duration_to_seconds(response.planning_time))
         seconds, echoed = timed_call(executor, echo, request)
         floor.append(seconds)
         size = len(serialize_message(response))

@@ -40,6 +40,7 @@ from peers import length_ratio, motion_length
 from punctured_planner.core import plan, Workspace
 from punctured_planner.core import refine as refinement_stage
 from punctured_planner.core.certificate import certify
+from punctured_planner.core.pairs import point_radii
 from refinement import each_fleet, excursion, PILLAR, RADIUS
 from scipy.optimize import linprog, minimize
 
@@ -245,7 +246,7 @@ def run_one(fleet) -> Outcome:
     for other in (refined, fixed, optimum):
         assert np.abs(_topology(other, fleet.pillars) - topology).max() < SAME_TOPOLOGY, (
             f'k={fleet.k} seed={fleet.seed}: the topology changed')
-    radii = np.concatenate([np.full(fleet.k, RADIUS), np.full(len(fleet.pillars), PILLAR)])
+    radii = point_radii(fleet.k, RADIUS, np.full(len(fleet.pillars), PILLAR))
     samples = np.linspace(0.0, 1.0, len(optimum.positions))
     shortfall = refined.margin - certify(samples, optimum.positions, fleet.pillars,
                                          radii).distance

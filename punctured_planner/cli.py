@@ -98,7 +98,6 @@ def _call(args):
             print('punctured-planner: service %s not available after %.1f s'
                   % (args.service, args.wait), file=sys.stderr)
             return EXIT_NO_SERVICE
-        ros.executor.add_node(ros.node)
         response = call_service(ros.executor, client, request, args.timeout)
         if response is None:
             print('punctured-planner: no response from %s within %.1f s'
@@ -133,8 +132,6 @@ def reset_obstacles(node: 'Node', executor: 'Executor', planner_node: str,
     if got is None or not got.values:
         return 'no obstacles parameter on %s' % planner_node
     current = parameter_value_to_python(got.values[0])
-    if current is None:  # obstacles: [] in a parameter file leaves no type: none
-        current = []
     try:  # integers too: the parameter is dynamically typed (obstacles: [0, 1, 0])
         values = [float(v) for v in current]
     except (TypeError, ValueError):
@@ -150,7 +147,6 @@ def reset_obstacles(node: 'Node', executor: 'Executor', planner_node: str,
 def _reset(args):
     from punctured_planner.ros.client import session
     with session(CLI_NODE) as ros:
-        ros.executor.add_node(ros.node)
         problem = reset_obstacles(ros.node, ros.executor, args.node, args.wait)
     if problem:
         print('punctured-planner: %s' % problem, file=sys.stderr)

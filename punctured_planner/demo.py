@@ -36,6 +36,11 @@ from typing import TYPE_CHECKING
 import numpy as np
 import yaml
 
+from .ros.topics import CMD_VEL
+from .ros.topics import ODOM
+from .ros.topics import REFERENCE_POSE
+from .ros.topics import robot_topic
+
 if TYPE_CHECKING:  # rclpy and ROS message types load where the demo runs them
     from nav_msgs.msg import Odometry
     from rclpy.executors import Executor
@@ -60,7 +65,7 @@ class Recorder:
     """A client node that records what the demo needs, with arrival times."""
 
     def __init__(self, node: 'Node', executor: 'Executor', names: list[str]) -> None:
-        """Subscribe node (in /demo, a client session's) and spin it with executor."""
+        """Subscribe node (in /demo, a client session's, spun by executor)."""
         from geometry_msgs.msg import PoseStamped
         from geometry_msgs.msg import Twist
         from nav_msgs.msg import Odometry
@@ -68,13 +73,8 @@ class Recorder:
         from std_msgs.msg import Float64
 
         from .ros.qos import LATCHED
-        from .ros.topics import CMD_VEL
-        from .ros.topics import ODOM
-        from .ros.topics import REFERENCE_POSE
-        from .ros.topics import robot_topic
         self.node = node
         self.executor = executor
-        self.executor.add_node(self.node)
         self.names = names
         self.messages: list[Heard] = []
         self.gap: list[float] = []
@@ -226,7 +226,7 @@ def _check_commands(mcap_path):
     with open(mcap_path, 'rb') as stream:
         commands = [message for _, channel, _, message in make_reader(
             stream, decoder_factories=[DecoderFactory()]).iter_decoded_messages()
-            if channel.topic.endswith('/cmd_vel')]
+            if channel.topic.endswith('/' + CMD_VEL)]
     sideways = sum(1 for message in commands if message.linear.y != 0.0)
     print('%s: %d cmd_vel messages, %d with a non-zero linear.y'
           % (mcap_path, len(commands), sideways))
@@ -240,7 +240,7 @@ def _write(recorder, response, mcap_path, gif_path):
     messages = recorder.messages
     write_mcap(mcap_path, [(h.topic, h.message) for h in messages],
                [h.arrival_ns for h in messages], {'plan_id': response.plan_id})
-    odometry = [h for h in messages if h.topic.endswith('/odom')]
+    odometry = [h for h in messages if h.topic.endswith('/' + ODOM)]
     index = {name: i for i, name in enumerate(recorder.names)}
     start = odometry[0].arrival_ns
     frames, times, current = [], [], None

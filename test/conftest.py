@@ -26,7 +26,6 @@ import signal
 import subprocess
 import sys
 import tempfile
-import time
 
 import pytest
 
@@ -122,13 +121,8 @@ class RosClient:
 
     def spin_until(self, predicate, timeout_sec=10.0):
         """Spin until ``predicate()`` is true; return whether it became true."""
-        deadline = time.monotonic() + timeout_sec
-        while not predicate():
-            remaining = deadline - time.monotonic()
-            if remaining <= 0:
-                return False
-            self.executor.spin_once(timeout_sec=min(remaining, 0.1))
-        return True
+        from punctured_planner.ros.client import spin_until
+        return spin_until(self.executor, predicate, timeout_sec)
 
     def close(self):
         """Shut the executor down, destroy the node, shut the Context down."""

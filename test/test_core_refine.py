@@ -195,7 +195,7 @@ def test_walls_never_take_a_robot_farther_out_and_keep_every_guarantee(request, 
     if before >= 0:
         assert after >= 0
     assert np.array_equal(motion.positions[motion.waypoint_indices], raw.configurations)
-    radii = np.concatenate([np.full(raw.positions.shape[1], radius), workspace.obstacle_radii])
+    radii = point_radii(raw.positions.shape[1], radius, workspace.obstacle_radii)
     gap = certify_bodies(motion.times, motion.positions, workspace.obstacles, radii).gap
     assert gap.distance >= motion.margin
 

@@ -290,15 +290,13 @@ class DiscLayout:
     walls: WallRoom | None
 
     @classmethod
-    def from_radii(cls, frame: Frame, obstacles: np.ndarray, robot_radius: float,
-                   obstacle_radius: np.ndarray, min_spacing: float,
-                   bounds: np.ndarray | None = None) -> 'DiscLayout':
+    def from_sizes(cls, frame: Frame, obstacles: np.ndarray, robot_radius: float,
+                   sizes: PillarClearance, bounds: np.ndarray | None = None) -> 'DiscLayout':
         """
-        Return the layout for pillars (r, d) of radii (r,), robots of radius R, walls bounds.
+        Return the layout for pillars (r, d) of sizes (PillarClearance), robots of radius R.
 
         bounds (d, 2), or None for no walls, give the room the walls leave (WallRoom).
         """
-        sizes = PillarClearance.from_radii(robot_radius, obstacle_radius, min_spacing)
         reach, apart, pitch = sizes.reach, sizes.apart, sizes.pitch
         offsets = frame.offset(obstacles)
         # Above every pillar's clearance (PillarClearance).

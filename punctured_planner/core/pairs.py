@@ -84,7 +84,8 @@ def first_equal_pair(points: np.ndarray,
     ordered = columns[order]
     same = np.all(ordered[1:] == ordered[:-1], axis=1)
     if groups is not None:
-        same &= groups[order][1:] == groups[order][:-1]
+        grouped = groups[order]
+        same &= grouped[1:] == grouped[:-1]
     hits = np.flatnonzero(same)
     if hits.size == 0:
         return None

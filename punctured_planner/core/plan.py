@@ -31,8 +31,8 @@ from .refine import block_count, Constraints, refine as refine_motion, Refinemen
 from .sections import compose, lane_heights, SCHEDULES, segment_times
 from .space import Workspace
 from .strata import epsilon, projection_count, projection_gaps
-from .timing import (corner_jump, leg_at, length_times, resample, speed_profile, SpeedProfile,
-                     stamps as timed_stamps, tracking_tolerance)
+from .timing import (leg_at, length_times, resample, SpeedProfile, stamps as timed_stamps,
+                     tolerance_profile, tracking_tolerance)
 from .validation import validate_configurations
 from .walls import smallest_leg_slack, WallSlack
 
@@ -274,9 +274,8 @@ class Plan:
         positions default to the breakpoints; Plan.sample passes them without
         the repeated ones, which leaves every stamp as it is.
         """
-        return speed_profile(self.positions if positions is None else positions, max_speed,
-                             max_acceleration,
-                             corner_jump(max_acceleration, self.tracking_tolerance))
+        return tolerance_profile(self.positions if positions is None else positions, max_speed,
+                                 max_acceleration, self.tracking_tolerance)
 
     def stamps(self, max_speed: float, max_acceleration: float = 0.0) -> np.ndarray:
         """

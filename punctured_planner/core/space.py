@@ -157,10 +157,16 @@ class Workspace:
         With bodies, a required gap c is planned for by inflating every body by
         c / 2: a gap >= 0 between the inflated bodies is a gap >= c between the real ones.
         """
+        return DiscLayout.from_sizes(self.frame, self.obstacles,
+                                     self.robot_radius + self._inflation(),
+                                     self._pillar_clearance, self.bounds)
+
+    @cached_property
+    def _pillar_clearance(self) -> PillarClearance:
+        """Return the pillars' reaches, pitches and clearances for the bodies as planned."""
         inflation = self._inflation()
-        return DiscLayout.from_radii(self.frame, self.obstacles, self.robot_radius + inflation,
-                                     self.obstacle_radii + inflation, self.min_spacing,
-                                     self.bounds)
+        return PillarClearance.from_radii(self.robot_radius + inflation,
+                                          self.obstacle_radii + inflation, self.min_spacing)
 
     def _inflation(self) -> float:
         """Return what every body's radius is planned with more: half the required gap c."""
@@ -180,13 +186,9 @@ class Workspace:
             return choose_frame(self.obstacles, self.bounds)
         if self.bounds is None:
             return choose_frame(self.obstacles, oblique=True, robot_radius=self.robot_radius)
-        inflation = self._inflation()
-        clearance = PillarClearance.from_radii(self.robot_radius + inflation,
-                                               self.obstacle_radii + inflation,
-                                               self.min_spacing)
         return choose_frame(self.obstacles, self.bounds, oblique=True,
-                            robot_radius=self.robot_radius + inflation,
-                            clearance=clearance.clear)
+                            robot_radius=self.robot_radius + self._inflation(),
+                            clearance=self._pillar_clearance.clear)
 
 
 def _checked_radii(robot_radius, obstacle_radius, obstacle_count):

@@ -199,6 +199,13 @@ def speed_profile(positions: np.ndarray, max_speed: float, max_acceleration: flo
     return SpeedProfile(lengths, speeds, float(max_speed), float(max_acceleration))
 
 
+def tolerance_profile(positions: np.ndarray, max_speed: float, max_acceleration: float,
+                      tolerance: float) -> SpeedProfile:
+    """Return the speed_profile whose corners spend their share of tolerance (corner_jump)."""
+    return speed_profile(positions, max_speed, max_acceleration,
+                         corner_jump(max_acceleration, tolerance))
+
+
 def fleet_profile(positions: np.ndarray, max_speeds: np.ndarray,
                   max_accelerations: np.ndarray, tolerance: float,
                   stops: np.ndarray | None = None) -> SpeedProfile:
@@ -282,8 +289,7 @@ def stamps(positions: np.ndarray, max_speed: float, max_acceleration: float,
     """
     if max_acceleration == 0:
         return breakpoint_stamps(positions, max_speed)
-    return speed_profile(positions, max_speed, max_acceleration,
-                         corner_jump(max_acceleration, tolerance)).stamps()
+    return tolerance_profile(positions, max_speed, max_acceleration, tolerance).stamps()
 
 
 def resample(values: npt.ArrayLike, positions: np.ndarray, samples_per_leg: int,

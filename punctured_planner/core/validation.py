@@ -215,36 +215,37 @@ def validate_configurations(configurations: npt.ArrayLike, obstacles: np.ndarray
                             coordinate=axis)
     coincident, on_obstacle = _coincidences(checked, obstacles)
     if coincident is not None:
-        m, a, b = coincident.configuration, coincident.first, coincident.second
+        both = [coincident.first, coincident.second]
         raise PlanningError(ErrorCode.ROBOTS_COINCIDE,
-                            f'{{configuration}}: robots {a} and {b} are at the same point '
-                            f'{checked[m, a].tolist()}', configuration=m, robots=[a, b])
+                            f'{{configuration}}: robots {both[0]} and {both[1]} are at the same '
+                            f'point {checked[coincident.configuration, both[0]].tolist()}',
+                            configuration=coincident.configuration, robots=both)
     if on_obstacle is not None:
-        m, robot, obstacle = on_obstacle.configuration, on_obstacle.first, on_obstacle.second
         raise PlanningError(ErrorCode.ROBOT_ON_OBSTACLE,
-                            f'{{configuration}}: robot {robot} is on {{obstacle}}',
-                            configuration=m, robots=[robot], obstacle=obstacle,
-                            point=obstacles[obstacle].tolist())
+                            f'{{configuration}}: robot {on_obstacle.first} is on {{obstacle}}',
+                            configuration=on_obstacle.configuration, robots=[on_obstacle.first],
+                            obstacle=on_obstacle.second,
+                            point=obstacles[on_obstacle.second].tolist())
     if obstacle_radii is None:
         obstacle_radii = np.zeros(len(obstacles))
     overlap, on_obstacle = _first_overlap(checked, obstacles, robot_radius,
                                           obstacle_radii)
     if overlap is not None:
-        m, a, b = overlap.configuration, overlap.first, overlap.second
         apart, least = compared(overlap.distance, 2 * robot_radius)
         raise PlanningError(ErrorCode.ROBOTS_COINCIDE,
-                            f'{{configuration}}: the discs of robots {a} and {b} overlap: '
-                            f'centres {apart} apart, less than 2 robot_radius = {least}',
-                            configuration=m, robots=[a, b])
+                            f'{{configuration}}: the discs of robots {overlap.first} and '
+                            f'{overlap.second} overlap: centres {apart} apart, less than 2 '
+                            f'robot_radius = {least}', configuration=overlap.configuration,
+                            robots=[overlap.first, overlap.second])
     if on_obstacle is not None:
-        m, robot, obstacle = on_obstacle.configuration, on_obstacle.first, on_obstacle.second
+        obstacle = on_obstacle.second
         apart, least = compared(on_obstacle.distance, robot_radius + obstacle_radii[obstacle])
         raise PlanningError(ErrorCode.ROBOT_ON_OBSTACLE,
-                            f'{{configuration}}: robot {robot} overlaps {{obstacle}}: '
-                            f'centres {apart} apart, less than robot_radius + obstacle_radius '
-                            f'= {least}',
-                            configuration=m, robots=[robot], obstacle=obstacle,
-                            point=obstacles[obstacle].tolist())
+                            f'{{configuration}}: robot {on_obstacle.first} overlaps '
+                            f'{{obstacle}}: centres {apart} apart, less than robot_radius + '
+                            f'obstacle_radius = {least}',
+                            configuration=on_obstacle.configuration, robots=[on_obstacle.first],
+                            obstacle=obstacle, point=obstacles[obstacle].tolist())
     if bounds is not None:
         _reject_outside(checked, bounds, robot_radius)
     return checked

@@ -177,10 +177,9 @@ class Step:
         A holonomic robot's velocity rotated into its frame; a differential robot's
         (forward, 0, 0): never a sideways part. The yaw rates are yaw_rates.
         """
-        commands = Rotation.from_quat(orientations).apply(self.velocities, inverse=True)
-        commands[self.differential] = 0.0
-        commands[self.differential, 0] = self.forward[self.differential]
-        return commands
+        rotated = Rotation.from_quat(orientations).apply(self.velocities, inverse=True)
+        return np.where(self.differential[:, None], unicycle.forward_vectors(self.forward),
+                        rotated)
 
 
 def behind(lags: np.ndarray, motion: np.ndarray) -> np.ndarray:
@@ -306,19 +305,19 @@ class Execution:
         driving = self._driving(angles)
         late = self._late(ages, dt)
         # the stale robots' positions say nothing: the others' errors still slow the clock
-        seen = min(clock_rate(np.where(stale, 0.0, watched), self.tolerance,
-                              s.slow_fraction, s.hold_fraction),
-                   self._differential_cap(alpha))
+        shown = np.where(stale, 0.0, watched)
         watched = watched + late * self.commanded_speeds  # what the robots may have moved
-        allowed = min(seen, clock_rate(np.where(stale, 0.0, watched), self.tolerance,
-                                       s.slow_fraction, s.hold_fraction))
         if not s.shared_clock:
             rate = allowed = 1.0
-        elif stale.any():
-            rate, allowed = min(self._braked(0.0, dt), seen), 0.0
         else:
-            # what old odometry may hide brakes the clock; what it shows may hold it
-            rate = self._rate_rise(min(seen, self._braked(allowed, dt)), dt)
+            seen = min(clock_rate(shown, self.tolerance, s.slow_fraction, s.hold_fraction),
+                       self._differential_cap(alpha))
+            allowed = 0.0 if stale.any() else min(seen, clock_rate(
+                watched, self.tolerance, s.slow_fraction, s.hold_fraction))
+            # what stale or old odometry may hide brakes the clock (a rate below the one
+            # before, so no rise is left); what it shows may hold it
+            change = self._rate_change(motion)
+            rate = self._rate_rise(min(seen, self._braked(allowed, dt, change)), dt, change)
         self.rate = rate
         duration = self.reference.duration
         self.plan_time = min(duration, self.plan_time + rate * dt)
@@ -392,21 +391,22 @@ class Execution:
             return np.zeros(self.reference.robot_count)
         return np.maximum(np.asarray(ages, dtype=float) - dt, 0.0)
 
-    def _rate_change(self) -> float:
+    def _rate_change(self, motion: np.ndarray) -> float:
         """
         Return how fast (1/s^2) the clock's rate may change under the acceleration limits.
 
         The rate change that moves every reference's velocity rate x r_i'(s) by
-        at most its robot's a_i (the plan's share, or the robot's own) per second.
+        at most its robot's a_i (the plan's share, or the robot's own) per second;
+        motion (k, 3) is the references' velocity now (r_i'(s)).
         """
-        speeds = np.linalg.norm(self.reference.velocity(self.plan_time), axis=1)
+        speeds = np.linalg.norm(motion, axis=1)
         return float(np.min(self.accelerations / np.maximum(speeds, ADAPT_SPEED)))
 
-    def _rate_rise(self, wanted: float, dt: float) -> float:
+    def _rate_rise(self, wanted: float, dt: float, change: float) -> float:
         """
         Return wanted, or less where the clock would speed up faster than the plan allows.
 
-        Under acceleration limits the clock rises no faster than _rate_change:
+        Under acceleration limits the clock rises no faster than change (_rate_change):
         released from a hold at once, a robot limited to a_i would lag its
         reference's jump by up to v^2 / (2 a_i) and hold the clock again. It
         still slows and holds at once for the robots' errors. A plan without
@@ -414,9 +414,9 @@ class Execution:
         """
         if self.reference.profile is None:
             return wanted
-        return min(wanted, self.rate + self._rate_change() * dt)
+        return min(wanted, self.rate + change * dt)
 
-    def _braked(self, wanted: float, dt: float) -> float:
+    def _braked(self, wanted: float, dt: float, change: float) -> float:
         """
         Return wanted, or more where the clock would slow down faster than the robots can.
 
@@ -425,14 +425,14 @@ class Execution:
         fast as the robot goes once its odometry stops and had held the clock
         within 0.25 s, before the robot even counted as stale. Without an
         acceleration limit the clock follows wanted at once. Under one it brakes
-        no faster than _rate_change, every robot following its braking reference,
+        no faster than change (_rate_change), every robot following its braking reference,
         a stale one on its feed-forward alone (step): held at once, each robot at
         v overran its stopped reference by v^2 / (2 a_i) (a probe over DDS: 0.26 m
         against a tolerance of 0.15 m at 0.75 m/s and 1 m/s^2).
         """
         if self.reference.profile is None:
             return wanted
-        return max(wanted, self.rate - self._rate_change() * dt)
+        return max(wanted, self.rate - change * dt)
 
     def _feedforward(self, rate: float, dt: float, lags: np.ndarray,
                      stale: np.ndarray) -> np.ndarray:

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.timing import corner_jump, fleet_profile, leg_at, speed_profile, SpeedProfile
+from ..core.timing import fleet_profile, leg_at, SpeedProfile, tolerance_profile
 
 
 @dataclass(frozen=True)
@@ -66,8 +66,7 @@ class Reference:
         if max_acceleration <= 0:
             return cls(seconds, positions, orientations)
         return cls(seconds, positions, orientations,
-                   speed_profile(positions, max_speed, max_acceleration,
-                                 corner_jump(max_acceleration, tolerance)))
+                   tolerance_profile(positions, max_speed, max_acceleration, tolerance))
 
     def retimed(self, max_speeds: np.ndarray, max_accelerations: np.ndarray,
                 tolerance: float, stops: np.ndarray | None = None) -> 'Reference':

@@ -29,7 +29,6 @@ still, towards its next move, and after the plan's end, to its final heading.
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from ..core.timing import leg_at
 
@@ -98,7 +97,15 @@ def yaws(quaternions: np.ndarray) -> np.ndarray:
 
 def yaw_quaternions(angles: np.ndarray) -> np.ndarray:
     """Return the (k, 4) quaternions (x, y, z, w) of (k,) yaw angles about z: yaws' inverse."""
-    return Rotation.from_euler('z', np.asarray(angles, dtype=float).reshape(-1, 1)).as_quat()
+    half = 0.5 * np.asarray(angles, dtype=float).reshape(-1)
+    return np.stack([np.zeros_like(half), np.zeros_like(half), np.sin(half), np.cos(half)],
+                    axis=-1)
+
+
+def forward_vectors(forward: np.ndarray) -> np.ndarray:
+    """Return the (k, 3) body-frame vectors (forward, 0, 0) of (k,) forward speeds."""
+    forward = np.asarray(forward, dtype=float)
+    return np.stack([forward, np.zeros_like(forward), np.zeros_like(forward)], axis=-1)
 
 
 def headings(angles: np.ndarray) -> np.ndarray:

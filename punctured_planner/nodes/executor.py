@@ -517,13 +517,12 @@ class PlanExecutor(Node):
         """
         plan = run.plan
         header = conversions.header(plan.frame_id, now_ns)
-        commands = step.body_commands(state.orientations)
-        velocity_mode = run.mode == 'velocity'
+        commands = step.body_commands(state.orientations) if run.mode == 'velocity' else None
         for i, name in enumerate(plan.names):
             link = self._links[name]
             link.reference.publish(conversions.pose_stamped(header, step.positions[i],
                                                             step.orientations[i]))
-            if velocity_mode:
+            if commands is not None:
                 link.cmd_vel.publish(conversions.twist(commands[i], step.yaw_rates[i]))
 
     def _stop_robots(self, run: Run) -> None:

@@ -47,7 +47,6 @@ import functools
 import gc
 import sys
 import threading
-import time
 import traceback
 from typing import Any
 import warnings
@@ -266,14 +265,19 @@ class PlannerNode(Node):
         if self._collecting:
             gc.enable()
 
+    def _past_planning(self) -> Stop | None:
+        """Return the stop under way once only replies go out (runtime.Stop), else None."""
+        stop = self._stop
+        return stop if stop is not None and stop.planning_over() else None
+
     def _plan_request(self, request: PlanSequence.Request,
                       response: PlanSequence.Response) -> PlanSequence.Response:
         """Plan one request against a snapshot; keep what to log and publish after the reply."""
         self._request_count += 1
         number = self._answering = self._request_count
-        if self._stop is not None and self._stop.planning_over():
+        if (stop := self._past_planning()) is not None:
             refuse_stopping(response, self.get_name(), number, len(request.configurations),
-                            time.monotonic() - self._stop.began)
+                            stop.elapsed())
             self.get_logger().warning('plan_sequence #%d: %s' % (number, response.error_msg))
             return response
         now_ns = self.get_clock().now().nanoseconds
@@ -329,13 +333,13 @@ class PlannerNode(Node):
             after, self._after_reply = self._after_reply, None
             if after is not None:
                 self._log_outcome(after)
-                if after.outcome.ok and self._stop is not None and self._stop.planning_over():
+                if after.outcome.ok and (stop := self._past_planning()) is not None:
                     # Publishing the largest plan took 10 s more: the stop must end, and
                     # the caller has its plan in the reply.
                     self.get_logger().warning(
                         'plan_sequence #%d: plan %d answered %.0f s into the stop: not '
                         'published' % (after.number, after.outcome.plan_id,
-                                       time.monotonic() - self._stop.began))
+                                       stop.elapsed()))
                 elif after.outcome.ok:
                     self._publish_after_reply(after)
 

@@ -89,7 +89,7 @@ def wait_for_result(executor: Executor, handle: ClientGoalHandle, watch: GoalWat
 
 @dataclass(frozen=True)
 class Session:
-    """A client's node and the executor that spins it (the node not yet added to it)."""
+    """A client's node and the executor that spins it (the node added to it)."""
 
     node: Node
     executor: Executor
@@ -102,6 +102,7 @@ def session(name: str, namespace: str | None = None) -> Iterator[Session]:
     rclpy.init(context=context)
     executor = SingleThreadedExecutor(context=context)
     node = rclpy.create_node(name, namespace=namespace, context=context)
+    executor.add_node(node)
     try:
         yield Session(node, executor)
     finally:

@@ -199,7 +199,7 @@ def duration_from_seconds(seconds: float) -> Duration:
 
 def duration_to_seconds(duration: Duration) -> float:
     """Return a builtin_interfaces/Duration as seconds (from its integer nanoseconds)."""
-    return (int(duration.sec) * 1000000000 + int(duration.nanosec)) * 1e-9
+    return stamp_to_ns(duration) * 1e-9
 
 
 # ---------------------------------------------------------------- arrays -> messages
@@ -456,10 +456,9 @@ def plan_reference(msg: Plan) -> Reference:
         raise InvalidPlan(plan_id, 'paths', ' has %d robot_names and %d paths, one per robot'
                           % (len(msg.robot_names), len(msg.paths)))
     try:
-        ros_names('plan %d: robot_names' % plan_id, tuple(msg.robot_names))
-    except ValueError as error:  # worded 'plan <id>: robot_names ...' already
-        raise InvalidPlan(plan_id, 'robot_names',
-                          str(error)[len('plan %d' % plan_id):]) from None
+        ros_names('robot_names', tuple(msg.robot_names))
+    except ValueError as error:  # worded 'robot_names ...'
+        raise InvalidPlan(plan_id, 'robot_names', ': %s' % error) from None
     arrays = [path_arrays(path) for path in msg.paths]
     stamps = [a.stamps for a in arrays]
     if not stamps or stamps[0].size < 2:

@@ -163,8 +163,9 @@ class FleetState:
     The robots of a plan at one control step.
 
     positions (k, 3) and orientations (k, 4) (a stale robot keeps the plan's
-    start and the identity), the stale robots' names and (k,) mask, the (k,)
-    ages of the odometry by arrival (s; 0 for a stale robot) and
+    start and its last orientation heard, else the identity), the stale robots'
+    names and (k,) mask, the (k,) ages of the odometry by arrival (s; 0 for a
+    stale robot) and
     ``wrong_frame``: the first robot whose odometry is in another frame than
     the plan's (None when none is).
     """

@@ -44,8 +44,6 @@ _KINDS = {
     'string_array': ParameterType.PARAMETER_STRING_ARRAY,
     'double_array': ParameterType.PARAMETER_DOUBLE_ARRAY,
 }
-# The list kinds, by rclpy's Parameter.Type names (an empty list alone it types a byte array).
-_LIST_TYPES = {'string_array': 'STRING_ARRAY', 'double_array': 'DOUBLE_ARRAY'}
 # Names usable as the first token of '<name>/plan', '<name>/odom' and '<name>/cmd_vel'.
 _NAME = re.compile(r'^[A-Za-z_][A-Za-z0-9_]*(/[A-Za-z_][A-Za-z0-9_]*)*$')
 
@@ -229,10 +227,10 @@ def lengths(name: str, value: float | tuple) -> None:
 
 def ros_names(name: str, value: tuple) -> None:
     """Refuse names that are not unique relative ROS names."""
-    for item in value:
+    for index, item in enumerate(value):
         if not _NAME.match(item):
             raise InvalidParameter(name, '%s: %r is not a valid relative ROS name'
-                                   % (name, item), index=value.index(item))
+                                   % (name, item), index=index)
     if len(set(value)) != len(value):
         raise InvalidParameter(name, '%s must be unique, got %r' % (name, list(value)))
 
@@ -395,9 +393,10 @@ class NodeParameters(Generic[S]):
         dump`` wrote null, and loading that dump was refused.
         """
         from rclpy.parameter import Parameter  # the node's: rclpy is loaded
-        empty = [Parameter(spec.name, Parameter.Type[_LIST_TYPES[spec.kind]], [])
+        # rclpy's Parameter.Type values are rcl_interfaces' ParameterType's (_KINDS)
+        empty = [Parameter(spec.name, Parameter.Type(_KINDS[spec.kind]), [])
                  for spec in self._table.specs
-                 if spec.kind in _LIST_TYPES and not spec.read_only
+                 if spec.kind.endswith('_array') and not spec.read_only
                  and not self._node.get_parameter(spec.name).value]
         if empty:
             self._node.set_parameters(empty)

@@ -168,8 +168,11 @@ class PlanSequenceHandler:
                     and len(changed & {'obstacles', 'obstacle_radius'}) == 1 else '')
             # The parameters involved, those that changed first; the core's PlanningError
             # (code, obstacle, wall, option) stays as the cause.
-            involved = {'obstacles', error.option or 'obstacles',
-                        'workspace_bounds' if error.wall is not None else 'obstacles'}
+            involved = {'obstacles'}
+            if error.option is not None:
+                involved.add(error.option)
+            if error.wall is not None:
+                involved.add('workspace_bounds')
             raise InvalidParameter(
                 tuple(sorted(involved & changed) + sorted(involved - changed)),
                 '%s with %s: %s%s' % (error.code.name, obstacles.describe(),

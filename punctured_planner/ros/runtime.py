@@ -194,6 +194,11 @@ class StopSignals:
             pass  # the pipe is full of wake-ups already
 
 
+def _with_traceback(words: str, error: BaseException) -> str:
+    """Return a log line: words, then the error's traceback."""
+    return words + ':\n' + ''.join(traceback.format_exception(error))
+
+
 def _never() -> bool:
     """Return False: a condition that never ends a wait."""
     return False
@@ -236,9 +241,13 @@ class Stop:
     began: float
     lingering: bool = False
 
+    def elapsed(self) -> float:
+        """Return the seconds since the stop signal."""
+        return time.monotonic() - self.began
+
     def planning_over(self) -> bool:
         """Return whether only replies go out now: STOP_PLANNING_SEC in, or lingering."""
-        return self.lingering or time.monotonic() - self.began > STOP_PLANNING_SEC
+        return self.lingering or self.elapsed() > STOP_PLANNING_SEC
 
 
 class ExecutorThreads:
@@ -296,8 +305,7 @@ class ExecutorThreads:
             pass  # the Context was shut down by someone else: nothing left to spin
         except BaseException as error:  # noqa: B902 - logged, then the process stops
             self.failure = error
-            node.get_logger().fatal('callback raised, stopping:\n' + ''.join(
-                traceback.format_exception(error)))
+            node.get_logger().fatal(_with_traceback('callback raised, stopping', error))
             if self._on_failure is not None:
                 self._on_failure()
 
@@ -437,8 +445,7 @@ class ExecutorThreads:
                 self._answer_waiting(node)
             except Exception as error:  # noqa: B902 - logged; the exit code says it
                 self.failure = self.failure or error
-                node.get_logger().error('callback raised while stopping:\n' + ''.join(
-                    traceback.format_exception(error)))
+                node.get_logger().error(_with_traceback('callback raised while stopping', error))
 
     def _awaited(self) -> bool:
         """Return whether a client may still be waiting for a reply written before the stop."""

@@ -421,6 +421,10 @@ class FleetSimSettings:
             max_yaw_acceleration=self.max_yaw_acceleration)
 
 
+# The parameter whose length counts the items a one-or-each setting must fit.
+_COUNTED_BY = {'robots': 'robot_names', 'obstacles': 'obstacles'}
+
+
 def _fleet_counts(settings: FleetSimSettings) -> None:
     """Refuse other than 3 coordinates, one factor, latency and drive per robot; unknown muted."""
     count = len(settings.robot_names)
@@ -439,14 +443,13 @@ def _fleet_counts(settings: FleetSimSettings) -> None:
         one_or_each('obstacle_radius', settings.obstacle_radius, len(settings.obstacles) // 3,
                     'obstacles')
     except WrongCount as error:  # the setting, and the parameter it must fit
-        raise InvalidParameter(
-            (error.name, 'obstacles' if error.items == 'obstacles' else 'robot_names'),
-            str(error)) from error
-    unknown = [name for name in settings.muted_robots if name not in settings.robot_names]
+        raise InvalidParameter((error.name, _COUNTED_BY[error.items]), str(error)) from error
+    unknown = [(index, name) for index, name in enumerate(settings.muted_robots)
+               if name not in settings.robot_names]
     if unknown:
         raise InvalidParameter(('muted_robots', 'robot_names'),
                                'muted_robots names %s, not among robot_names'
-                               % ', '.join(unknown), index=settings.muted_robots.index(unknown[0]))
+                               % ', '.join(name for _, name in unknown), index=unknown[0][0])
 
 
 FLEET_SIM = Table('fleet_sim', FleetSimSettings, checks=(_fleet_counts,))

@@ -39,8 +39,11 @@ def in_other_frame(frame_id: str, planning_frame: str) -> bool:
     return bool(frame_id) and frame_id != planning_frame
 
 
-# Why a snapshot has no robot state: the words before ')' or the robots' odometry topics.
-NO_STATE = 'no robot state received yet (topic robot_states'
+def missing_state(missing: list[str] | tuple = ()) -> str:
+    """Return why a snapshot has no robot state: nothing on robot_states, nor from missing."""
+    odometry = (', or odometry from %s' % ', '.join(robot_topic(n, ODOM) for n in missing)
+                if missing else '')
+    return 'no robot state received yet (topic robot_states%s)' % odometry
 
 
 @dataclass(frozen=True, eq=False)
@@ -99,7 +102,7 @@ class Snapshot:
     settings: PlannerSettings
     obstacles: ObstacleSet
     state: RobotState | None = None
-    state_problem: str = NO_STATE + ')'
+    state_problem: str = missing_state()
 
     def describe(self) -> str:
         """Return the log line of the snapshot."""
@@ -188,10 +191,7 @@ def take_snapshot(settings: PlannerSettings, obstacles: ObstacleSet,
     if candidates:
         return Snapshot(settings, obstacles,
                         max(candidates, key=lambda state: state.received_ns), '')
-    problem = NO_STATE
-    if names:
-        problem += ', or odometry from %s' % ', '.join(robot_topic(n, ODOM) for n in missing)
-    return Snapshot(settings, obstacles, None, problem + ')')
+    return Snapshot(settings, obstacles, None, missing_state(missing))
 
 
 def _point(point):

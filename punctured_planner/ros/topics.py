@@ -16,4 +16,4 @@ REFERENCE_POSE = 'reference_pose'
 
 def robot_topic(robot: str, topic: str) -> str:
     """Return the topic of a robot, '<robot>/<topic>': 'robot_0/odom' for robot_0's ODOM."""
-    return '%s/%s' % (robot.strip('/'), topic)
+    return '%s/%s' % (robot, topic)

@@ -34,6 +34,7 @@ from ..core.pairs import PointPair
 from ..execution.bodies import Bodies
 from ..execution.execution import ExecutionSettings
 from ..execution.execution import saturate
+from ..execution.unicycle import forward_vectors
 from ..execution.unicycle import headings
 from ..execution.unicycle import wrap
 from ..execution.unicycle import yaw_quaternions
@@ -151,9 +152,8 @@ class Fleet:
         A differential robot's is (forward, 0, 0); a holonomic robot faces +x, so
         its body frame is the world's.
         """
-        forward = np.zeros_like(self.velocities)
-        forward[:, 0] = self.forward
-        return np.where(self.differential[:, None], forward, self.velocities)
+        return np.where(self.differential[:, None], forward_vectors(self.forward),
+                        self.velocities)
 
     @property
     def robot_count(self) -> int:
