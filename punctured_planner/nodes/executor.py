@@ -576,7 +576,7 @@ def executor_nodes(context: Context | None = None, **kwargs: Any) -> NodeGroup:
 
 def main(args: list[str] | None = None) -> int:
     """Run plan_executor until Ctrl-C or SIGTERM; return 0, or 2 for invalid parameters."""
-    return run_nodes(EXECUTOR.node_name, executor_nodes, args=args, parameters=EXECUTOR)
+    return run_nodes(EXECUTOR, executor_nodes, args=args)
 
 
 if __name__ == '__main__':

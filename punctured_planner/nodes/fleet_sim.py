@@ -127,8 +127,7 @@ def fleet_sim_nodes(context: Context | None = None, **kwargs: Any) -> NodeGroup:
 
 def main(args: list[str] | None = None) -> int:
     """Run fleet_sim until Ctrl-C or SIGTERM; return 0, or 2 for invalid parameters."""
-    return run_nodes(FLEET_SIM.node_name, fleet_sim_nodes, args=args,
-                     parameters=FLEET_SIM)
+    return run_nodes(FLEET_SIM, fleet_sim_nodes, args=args)
 
 
 if __name__ == '__main__':

@@ -427,7 +427,7 @@ def planner_nodes(context: Context | None = None, **kwargs: Any) -> NodeGroup:
 
 def main(args: list[str] | None = None) -> int:
     """Run the node until Ctrl-C or SIGTERM; return 0, or 2 for invalid parameters."""
-    return run_nodes(PLANNER.node_name, planner_nodes, args=args, parameters=PLANNER)
+    return run_nodes(PLANNER, planner_nodes, args=args)
 
 
 if __name__ == '__main__':

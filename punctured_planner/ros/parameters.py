@@ -324,12 +324,10 @@ class Table(Generic[S]):
                 raise InvalidParameterFile([path], '--params-file %s: not YAML: %s' % (
                     path, ' '.join(str(error).split()))) from None
             applies = applies or read.applies
-            unknown = sorted(set(read.values) - set(self.by_name))
-            if unknown:
-                raise InvalidParameterFile(
-                    [path], '%s: unknown parameter %r of %s (parameters: %s)'
-                    % (path, unknown[0], self.node_name, ', '.join(self.by_name)),
-                    parameter=unknown[0])
+            unknown = self._first_unknown(read.values)
+            if unknown is not None:
+                raise InvalidParameterFile([path], '%s: %s' % (path, self._unknown(unknown)),
+                                           parameter=unknown)
         if not applies:
             raise InvalidParameterFile(paths, '--params-file %s: %s'
                                        % (', '.join(paths), _no_section(self)))
@@ -341,16 +339,23 @@ class Table(Generic[S]):
         Raises InvalidParameter (a ValueError) whose message is the reason a value is
         refused; unknown names are refused too.
         """
-        merged = {}
-        for name, value in values.items():
-            if name not in self.by_name:
-                raise InvalidParameter(name, 'unknown parameter %r (parameters: %s)'
-                                       % (name, ', '.join(self.by_name)))
-            merged[name] = self.by_name[name].value(value)
-        settings = self.settings_type(**merged)
+        unknown = self._first_unknown(values)
+        if unknown is not None:
+            raise InvalidParameter(unknown, self._unknown(unknown))
+        settings = self.settings_type(**{name: self.by_name[name].value(value)
+                                         for name, value in values.items()})
         for check in self._checks:
             check(settings)
         return settings
+
+    def _first_unknown(self, names: Iterable[str]) -> str | None:
+        """Return the first of names (sorted) that is none of the node's parameters, if any."""
+        return min(set(names) - set(self.by_name), default=None)
+
+    def _unknown(self, name: str) -> str:
+        """Return the reason an unknown parameter name is refused, naming the known ones."""
+        return 'unknown parameter %r of %s (parameters: %s)' % (
+            name, self.node_name, ', '.join(self.by_name))
 
 
 class NodeParameters(Generic[S]):

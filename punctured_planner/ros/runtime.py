@@ -16,6 +16,9 @@ Use::
         return run_nodes('my_node', lambda context: NodeGroup([MyNode(context=context)]),
                          args=args)
 
+or, for a node with a parameter table (ros.parameters.Table), ``run_nodes(TABLE, ...)``:
+the process is named after the table's node and checks its parameter files.
+
 ``make_nodes(context)`` returns the :class:`NodeGroup` to spin; each node gets its own
 SingleThreadedExecutor in its own thread, so a slow callback on one node never
 blocks another (give subscriptions their own node for that). In tests, or
@@ -473,23 +476,24 @@ class ExecutorThreads:
         return True
 
 
-def run_nodes(name: str, make_nodes: Callable[[Context], NodeGroup],
-              args: Optional[List[str]] = None, timeout_sec: float = STOP_TIMEOUT_SEC,
-              parameters: Optional[Table] = None) -> int:
+def run_nodes(process: Table | str, make_nodes: Callable[[Context], NodeGroup],
+              args: Optional[List[str]] = None,
+              timeout_sec: float = STOP_TIMEOUT_SEC) -> int:
     """
     Run a process's nodes until SIGINT or SIGTERM, stop them cleanly; return the exit code.
 
-    The whole ``main()`` of a node process (see the module docstring): check
-    the parameter files of ``args`` (sys.argv when None) against the node's
-    ``parameters`` table (Table.check_files), initialise a Context with them,
-    call ``make_nodes(context)``, spin each node in its thread, wait for a
-    stop signal, stop. Returns 0 after a
-    signal, 1 when a callback raised, 2 (with the reason on stderr) for a
-    parameter file the node cannot use or parameters ``make_nodes`` refused
-    (``name: invalid parameters:``), or arguments rcl refuses (``name: cannot
-    start:``). Call it from
-    the main thread.
+    The whole ``main()`` of a node process (see the module docstring). ``process``
+    is the node's parameter Table, which names the process and checks the
+    parameter files of ``args`` (sys.argv when None; Table.check_files), or the
+    name of a process whose nodes have no table. Then: initialise a Context with
+    the arguments, call ``make_nodes(context)``, spin each node in its thread,
+    wait for a stop signal, stop. Returns 0 after a signal, 1 when a callback
+    raised, 2 (with the reason on stderr) for a parameter file the node cannot
+    use or parameters ``make_nodes`` refused (``name: invalid parameters:``), or
+    arguments rcl refuses (``name: cannot start:``). Call it from the main thread.
     """
+    name, parameters = ((process.node_name, process) if isinstance(process, Table)
+                        else (process, None))
     with StopSignals() as signals:
         load_fastdds_profile()
         context = Context()

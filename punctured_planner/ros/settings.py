@@ -35,6 +35,7 @@ from ..execution import DRIVES
 from ..execution import ExecutionSettings
 from ..execution.execution import differential_mask
 from ..execution.execution import one_or_each
+from ..execution.execution import per_robot
 from ..execution.execution import WrongCount
 from ..sim import FleetSettings
 
@@ -401,14 +402,19 @@ class FleetSimSettings:
         return np.asarray(self.initial_positions, dtype=float).reshape(-1, 3)
 
     def fleet(self) -> FleetSettings:
-        """Return the fleet's physics: bodies, speed limit and factors, latencies, noise."""
+        """
+        Return the fleet's physics: bodies, speed limit and factors, latencies, noise.
+
+        Raises WrongCount for a one-or-each setting of another count (drive,
+        max_acceleration, obstacle_radius): _fleet_counts refuses those settings by it.
+        """
         obstacles = np.asarray(self.obstacles, dtype=float).reshape(-1, 3)
         radii = one_or_each('obstacle_radius', self.obstacle_radius, len(obstacles),
                             'obstacles')
         bodies = Bodies(self.robot_radius, obstacles,
                         np.zeros(len(obstacles)) if radii is None else radii.astype(float))
-        accelerations = one_or_each('max_acceleration', self.max_acceleration,
-                                    len(self.robot_names))
+        accelerations = per_robot('max_acceleration', self.max_acceleration,
+                                  len(self.robot_names))
         return FleetSettings(
             bodies=bodies, speed_limit=self.speed_limit,
             speed_factors=np.asarray(self.speed_factors) if self.speed_factors else None,
@@ -417,7 +423,7 @@ class FleetSimSettings:
             seed=self.seed, differential=differential_mask(self.drive, len(self.robot_names)),
             yaw_rate_limit=self.yaw_rate_limit,
             max_acceleration=(np.zeros(len(self.robot_names)) if accelerations is None
-                              else accelerations.astype(float)),
+                              else accelerations),
             max_yaw_acceleration=self.max_yaw_acceleration)
 
 
@@ -437,11 +443,8 @@ def _fleet_counts(settings: FleetSimSettings) -> None:
         if values and len(values) != count:
             raise InvalidParameter((name, 'robot_names'), '%s has %d values for %d robots'
                                    % (name, len(values), count))
-    try:
-        differential_mask(settings.drive, count)
-        one_or_each('max_acceleration', settings.max_acceleration, count)
-        one_or_each('obstacle_radius', settings.obstacle_radius, len(settings.obstacles) // 3,
-                    'obstacles')
+    try:  # the one-or-each settings, read where the simulator reads them
+        settings.fleet()
     except WrongCount as error:  # the setting, and the parameter it must fit
         raise InvalidParameter((error.name, _COUNTED_BY[error.items]), str(error)) from error
     unknown = [(index, name) for index, name in enumerate(settings.muted_robots)
