@@ -272,6 +272,32 @@ def test_the_parameters_hint_says_how_to_change_obstacles_and_radii_together():
     assert 'together' not in str(refused.value)
 
 
+def test_a_change_the_topics_obstacles_cannot_take_is_refused_on_set():
+    """
+    With the set from the topic in use, a change that would refuse every request is refused.
+
+    Three radii for the topic's two obstacles, or a wall the topic's pillar lies beyond,
+    were taken before and refused every request after (INVALID_REQUEST for a malformed
+    one); they name the changed parameter, never 'obstacles' (the parameter is not in use).
+    """
+    topic = ObstacleSet(np.array([[0.0, 0.0, 0.0], [2.0, 5.0, 0.0]]), 'map', '/obstacles', 5)
+    handler = PlanSequenceHandler()
+    radii = PLANNER.settings({'obstacle_radius': [0.1, 0.2, 0.3]})
+    with pytest.raises(ValueError) as refused:
+        handler.check_parameter_obstacles(radii, topic, {'obstacle_radius'})
+    assert 'obstacle_radius must be a scalar or one value per obstacle' in str(refused.value)
+    assert 'from topic /obstacles' in str(refused.value)
+    assert refused.value.parameters == ('obstacle_radius',)
+    walled = PLANNER.settings({'workspace_bounds': [-10.0, 10.0, -10.0, 2.0]})
+    with pytest.raises(ValueError) as refused:
+        handler.check_parameter_obstacles(walled, topic, {'workspace_bounds'})
+    assert refused.value.parameters == ('workspace_bounds',)
+    assert refused.value.__cause__.obstacle == 1
+    # what the topic's set can take is taken
+    handler.check_parameter_obstacles(PLANNER.settings({'obstacle_radius': [0.1, 0.2]}),
+                                      topic, {'obstacle_radius'})
+
+
 def test_free_text_in_a_message_is_never_read_as_a_slot():
     """A frame id with braces is quoted as it is (the message is a template)."""
     outcome = answer(make_request(frame_id='{configuration}'), snapshot(), 0)

@@ -146,14 +146,14 @@ class PlanSequenceHandler:
 
         For the node's on-set and start-up, and ``punctured-planner plan``'s parameter
         file: a new obstacles value (in changed) gets the checks a set arriving on the
-        topic gets (check_obstacles); a set in use from the parameter, when other
-        settings change, the core's Workspace rule (check_workspace: its
-        obstacle_radius count, obstacles beyond workspace_bounds). So plane_z or
-        frame_id may change first and the obstacles follow. A set from the topic is
-        checked when it arrives, and an empty set is not checked: per-obstacle radii
-        may wait for the topic's set.
+        topic gets (check_obstacles); the set in use, from the parameter or from the
+        topic, when other settings change, the core's Workspace rule (check_workspace:
+        its obstacle_radius count, obstacles beyond workspace_bounds), so no change is
+        taken that would refuse every request. So plane_z or frame_id may change first
+        and the obstacles follow. An empty set is not checked: per-obstacle radii may
+        wait for the topic's set.
         """
-        if not (obstacles.from_parameter and len(obstacles.points)):
+        if not len(obstacles.points):
             return
         try:
             (self.check_obstacles if 'obstacles' in changed
@@ -168,13 +168,15 @@ class PlanSequenceHandler:
                     and len(changed & {'obstacles', 'obstacle_radius'}) == 1 else '')
             # The parameters involved, those that changed first; the core's PlanningError
             # (code, obstacle, wall, option) stays as the cause.
-            involved = {'obstacles'}
+            involved = {'obstacles'} if obstacles.from_parameter else set()
             if error.option is not None:
                 involved.add(error.option)
             if error.wall is not None:
                 involved.add('workspace_bounds')
             raise InvalidParameter(
-                tuple(sorted(involved & changed) + sorted(involved - changed)),
+                # the changed ones where the core names no parameter (a topic's set)
+                tuple(sorted(involved & changed) + sorted(involved - changed))
+                or tuple(sorted(changed)),
                 '%s with %s: %s%s' % (error.code.name, obstacles.describe(),
                                       error.describe(ObstacleNames(obstacles.name)), hint)
             ) from error
