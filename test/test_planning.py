@@ -50,14 +50,25 @@ def test_over_limit_requests_are_refused_before_conversion(monkeypatch):
     assert converted == []
 
 
+def answer_poses(outcome):
+    """Return how many poses an answer's paths hold in all."""
+    return sum(len(path.poses) for path in outcome.response.paths)
+
+
 def test_discs_answers_over_max_poses_are_refused_once_planned():
-    """'discs' has no fixed legs: its pose count is checked against max_poses after planning."""
+    """
+    'discs' has no fixed legs: its pose count is checked against max_poses after planning.
+
+    The count is the answer's own: a leg in which no robot moves lasts no time and adds
+    no pose (this request has such legs), so an answer of exactly max_poses is given.
+    """
     from punctured_planner_interfaces.srv import PlanSequence
     flat = [v for o in OBSTACLES for v in o]
     planned = PlanSequenceHandler().handle(
         make_request(), PlanSequence.Response(),
         snapshot(obstacles=flat, robot_radius=0.1, samples_per_leg=0), 0)
-    poses = 4 * len(planned.plan.times)
+    poses = answer_poses(planned)
+    assert poses < 4 * len(planned.plan.times)
     limited = snapshot(obstacles=flat, robot_radius=0.1, samples_per_leg=0,
                        max_poses=poses - 1)
     outcome = PlanSequenceHandler().handle(make_request(), PlanSequence.Response(), limited, 0)
@@ -76,8 +87,8 @@ def test_refined_answers_are_checked_by_their_own_pose_count():
     refined = PlanSequenceHandler().handle(make_request(), PlanSequence.Response(),
                                            snapshot(obstacles=flat), 0)
     assert raw.ok and refined.ok and raw.plan.raw is None and refined.plan.raw is not None
-    poses = 4 * len(refined.plan.times)
-    assert 4 * len(raw.plan.times) < poses
+    poses = answer_poses(refined)
+    assert answer_poses(raw) < poses
     # Enough for the construction's breakpoints, not for the refined plan's.
     limited = snapshot(obstacles=flat, max_poses=poses - 1)
     outcome = PlanSequenceHandler().handle(make_request(), PlanSequence.Response(), limited, 0)
@@ -85,6 +96,36 @@ def test_refined_answers_are_checked_by_their_own_pose_count():
     assert 'more than max_poses %d' % (poses - 1) in outcome.response.error_msg
     enough = snapshot(obstacles=flat, max_poses=poses)
     assert PlanSequenceHandler().handle(make_request(), PlanSequence.Response(), enough, 0).ok
+
+
+def test_max_poses_leaves_out_what_the_current_state_drops():
+    """
+    max_poses is judged on the answer: configurations the current state drops add no pose.
+
+    Leading configurations that repeat the state are dropped once converted (design
+    section 12), so ten repeats before the goal do not make an answer of two
+    configurations' poses too many (the paper variant's count from its fixed legs,
+    before planning, took all twelve and refused it).
+    """
+    from punctured_planner.ros.snapshot import RobotState
+    from punctured_planner_interfaces.srv import PlanSequence
+    flat = [v for o in OBSTACLES for v in o]
+    start, goal = make_request().configurations[:2]
+    state = RobotState(conversions.pose_array_positions(start), np.tile([0.0, 0, 0, 1], (4, 1)),
+                       'map', 5, 'robot_states', 5)
+    request = make_request()
+    request.configurations = [start] * 10 + [goal]
+    request.use_current_state = True
+    values = {'obstacles': flat, 'variant': 'paper', 'samples_per_leg': 0, 'refine': False}
+    settings = PLANNER.settings(values)
+    obstacles = ObstacleSet(conversions.obstacles_from_parameter(settings.obstacles))
+    planned = PlanSequenceHandler().handle(request, PlanSequence.Response(),
+                                           Snapshot(settings, obstacles, state), 10)
+    assert planned.ok and list(planned.response.dropped_configurations) == list(range(10))
+    limited = PLANNER.settings({**values, 'max_poses': answer_poses(planned)})
+    outcome = PlanSequenceHandler().handle(request, PlanSequence.Response(),
+                                           Snapshot(limited, obstacles, state), 10)
+    assert outcome.ok, outcome.response.error_msg
 
 
 def test_array_holding_dataclasses_compare_by_identity():

@@ -16,9 +16,10 @@ production), in this run's own ROS_DOMAIN_ID, discovery on localhost only.
    answer equal to the plan of one (obstacles, state) snapshot.
 3. Restart: SIGKILL, start again; waiting clients get answers; a late
    transient-local subscriber gets nothing until a new plan, then that plan.
-4. Limits: over max_configurations, max_robots, max_poses, samples: refused with
+4. Limits: over max_configurations, max_robots, samples: refused with
    REQUEST_OVER_LIMITS, before any conversion (checked in the node's code path; the
-   planning times are printed, not asserted: the machine is shared and noisy).
+   planning times are printed, not asserted: the machine is shared and noisy); over
+   max_poses, refused once planned, with no paths.
 """
 
 import hashlib
@@ -37,7 +38,6 @@ from hypothesis import strategies as st
 from motion_check import assert_certificate_agrees
 import numpy as np
 from punctured_planner.core import ErrorCode, plan, PlanningError, Workspace
-from punctured_planner.core.sections import SPREAD_LEGS
 import pytest
 from reliability_client import build_request
 from reliability_client import CONFIGURATIONS
@@ -173,9 +173,8 @@ def documented_outcome(spec, state):
     counts = [len(c) for c in configurations]
     samples = spec['samples_per_leg']
     samples = samples if samples >= 0 else PARAMETERS['samples_per_leg']
-    poses = max(counts) * ((n - 1) * len(SPREAD_LEGS) * (samples + 1) + 1)
     if (n > PARAMETERS['max_configurations'] or max(counts) > PARAMETERS['max_robots']
-            or samples > MAX_SAMPLES_PER_LEG or poses > PARAMETERS['max_poses']):
+            or samples > MAX_SAMPLES_PER_LEG):
         return {CODE.REQUEST_OVER_LIMITS: None}, None
     if not math.isfinite(spec['max_speed']):
         return {CODE.INVALID_REQUEST: None}, None
@@ -190,9 +189,15 @@ def documented_outcome(spec, state):
     if fault is not None:
         return {fault[0]: fault[1]}, None
     try:
-        return {CODE.NONE: None}, plan(workspace(), np.stack(configurations)[..., :2])
+        planned = plan(workspace(), np.stack(configurations)[..., :2])
     except PlanningError as error:
         return {error.code: error.configuration}, None
+    # max_poses, once planned: the answer's own poses, a leg in which no robot moves
+    # adding none (its stamps repeat)
+    moved = 1 + int(np.any(np.diff(planned.positions, axis=0) != 0, axis=(1, 2)).sum())
+    if counts[0] * ((moved - 1) * (samples + 1) + 1) > PARAMETERS['max_poses']:
+        return {CODE.REQUEST_OVER_LIMITS: None}, None
+    return {CODE.NONE: None}, planned
 
 
 def ros_fault(configurations, frames, counts):
@@ -475,7 +480,6 @@ def over_limit_specs():
         ('configurations', spec_of(CONFIGURATIONS * 3)),
         ('robots', spec_of([crowd, crowd])),
         ('robots-20000', spec_of([huge, huge])),
-        ('poses', spec_of(CONFIGURATIONS, samples_per_leg=100)),
         ('samples', spec_of(two, samples_per_leg=MAX_SAMPLES_PER_LEG + 1)),
         ('configurations-with-state', spec_of(CONFIGURATIONS * 3, use_current_state=True)),
     ]
@@ -491,6 +495,12 @@ def test_requests_over_the_limits_are_refused_before_planning(node, client, serv
         assert response.error_code == CODE.REQUEST_OVER_LIMITS, (name, response.error_msg)
         assert list(response.paths) == []
         timings[name] = (stamp_ns(response.planning_time), received - sent)
+    # max_poses is known once planned: refused then, with no paths all the same
+    response, sent, received = call(client, service, spec_of(CONFIGURATIONS,
+                                                             samples_per_leg=100))
+    assert response.error_code == CODE.REQUEST_OVER_LIMITS, response.error_msg
+    assert 'more than max_poses' in response.error_msg and list(response.paths) == []
+    timings['poses'] = (stamp_ns(response.planning_time), received - sent)
     assert_serves_a_valid_request(client, service)
     node.assert_running()
     print('over-limit requests (planning ns, round trip ns): %s' % timings)

@@ -314,9 +314,7 @@ class Plan:
         """
         values = (self.times if max_speed is None
                   else self.stamps(max_speed, max_acceleration))
-        new = np.ones(values.size, dtype=bool)
-        new[1:] = (values[1:] != values[:-1]) | (
-            self.positions[1:] != self.positions[:-1]).any(axis=(1, 2))
+        new = self._distinct(values)
         # resample uses the profile only to stamp samples inside the legs: with none,
         # every stamp is a breakpoint's own.
         profile = (self.profile(max_speed, max_acceleration, self.positions[new])
@@ -327,6 +325,17 @@ class Plan:
         kept = new.cumsum() - 1
         step = max(int(samples_per_leg), 0) + 1
         return Samples(values, positions, kept[self.waypoint_indices] * step)
+
+    def stamped_breakpoints(self, max_speed: float, max_acceleration: float = 0.0) -> int:
+        """Return how many breakpoints sample keeps in stamps: the answer's count, unsampled."""
+        return int(self._distinct(self.stamps(max_speed, max_acceleration)).sum())
+
+    def _distinct(self, values: np.ndarray) -> np.ndarray:
+        """Return the (V,) mask of breakpoints kept: the first, then each new in value or pose."""
+        new = np.ones(values.size, dtype=bool)
+        new[1:] = (values[1:] != values[:-1]) | (
+            self.positions[1:] != self.positions[:-1]).any(axis=(1, 2))
+        return new
 
 
 def plan(workspace: Workspace, configurations: npt.ArrayLike, certify: bool = True,

@@ -30,12 +30,8 @@ class Schedule:
     legs: tuple[str, ...]
     fractions: tuple[float, ...]
 
-    def breakpoint_count(self, configuration_count: int) -> int:
-        """Return V, the number of breakpoints of a plan through n configurations."""
-        return (configuration_count - 1) * len(self.legs) + 1
 
-
-# The one table from variant to legs: Workspace, plan and the node's limits read it.
+# The one table from variant to legs: Workspace and plan read it.
 SCHEDULES = {
     'paper': Schedule(PAPER_LEGS, PAPER_FRACTIONS),
     'spread': Schedule(SPREAD_LEGS, SPREAD_FRACTIONS),

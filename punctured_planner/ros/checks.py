@@ -32,7 +32,6 @@ from ..core import ErrorCode
 from ..core import first_out_of_range
 from ..core import MAX_COORDINATE
 from ..core import PlanningError
-from ..core import SCHEDULES
 from ..core.errors import axis_name
 from ..core.errors import literal
 from ..core.limits import first_non_finite
@@ -141,7 +140,14 @@ def _check_state_age(settings: PlannerSettings, state: RobotState, now_ns: int) 
 
 
 def _check_limits(settings: PlannerSettings, n: int, counts: list[int], samples: int) -> None:
-    """REQUEST_OVER_LIMITS from lengths alone, before anything is converted."""
+    """
+    REQUEST_OVER_LIMITS from lengths alone, before anything is converted.
+
+    Not max_poses: an answer's pose count is known only once planned (check_poses),
+    as legs in which no robot moves add none, and with use_current_state leading
+    configurations that repeat the state are dropped. Counted from the variants'
+    fixed legs before planning, answers that fit were refused.
+    """
     if n > settings.max_configurations:
         fail(ErrorCode.REQUEST_OVER_LIMITS, '%d configurations, more than '
              'max_configurations %d' % (n, settings.max_configurations))
@@ -154,12 +160,6 @@ def _check_limits(settings: PlannerSettings, n: int, counts: list[int], samples:
     if samples > MAX_SAMPLES_PER_LEG:
         fail(ErrorCode.REQUEST_OVER_LIMITS, 'samples_per_leg %d is more than %d'
              % (samples, MAX_SAMPLES_PER_LEG))
-    schedule = SCHEDULES.get(settings.core_variant)
-    # The construction's breakpoints, fewer than the refined plan's: an early refusal
-    # before planning; the answer's own count is checked once planned ('discs' has no
-    # fixed legs, so only then).
-    if schedule is not None:
-        check_poses(settings, k, schedule.breakpoint_count(n), samples)
 
 
 def check_poses(settings: PlannerSettings, robot_count: int, breakpoints: int,

@@ -208,11 +208,12 @@ class PlanSequenceHandler:
         planning_time = time.perf_counter() - started
         start_ns = int(now_ns) + int(round(planning_time * 1e9))
         max_speed, max_acceleration = gathered.max_speed, settings.max_acceleration
-        # The plan's own breakpoints: the refinement's knots add to any schedule's.
-        checks.check_poses(settings, gathered.counts[0], len(the_plan.times),
-                           gathered.samples_per_leg)
         with np.errstate(over='ignore', divide='ignore', invalid='ignore'):
             duration = the_plan.duration(max_speed, max_acceleration)
+            # The answer's own breakpoints: the refinement's knots add to any schedule's,
+            # and a leg in which no robot moves adds none.
+            breakpoints = the_plan.stamped_breakpoints(max_speed, max_acceleration)
+        checks.check_poses(settings, gathered.counts[0], breakpoints, gathered.samples_per_leg)
         checks.check_duration(duration, max_speed, start_ns)
         samples = the_plan.sample(gathered.samples_per_leg, max_speed, max_acceleration)
         paths = conversions.plan_to_paths(samples, checked.orientations, settings.frame_id,
