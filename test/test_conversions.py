@@ -30,6 +30,10 @@ def test_quaternions_are_normalised_or_identity():
     q = conversions.normalized_quaternions([[0, 0, 2, 0], [0, 0, 0, 0], [math.nan, 0, 0, 1],
                                             [math.inf, 0, 0, 0]])
     assert q.tolist() == [[0, 0, 1, 0], [0, 0, 0, 1], [0, 0, 0, 1], [0, 0, 0, 1]]
+    # finite ones whose sum of squares overflows or underflows are still normalised
+    q = conversions.normalized_quaternions([[1e200, 0, 0, 0], [0, 1e-170, 0, 0],
+                                            [1e308, 1e308, 0, 0]])
+    assert np.allclose(q, [[1, 0, 0, 0], [0, 1, 0, 0], [0.5 ** 0.5, 0.5 ** 0.5, 0, 0]])
 
 
 def test_message_arrays_round_trip():

@@ -128,6 +128,41 @@ def test_max_poses_leaves_out_what_the_current_state_drops():
     assert outcome.ok, outcome.response.error_msg
 
 
+def test_a_plan_refused_for_the_resolution_reports_the_gap_it_found():
+    """
+    min_gap reports the value found, as min_clearance does, when rounding is the reason.
+
+    A robot 1e15 away makes the coordinates' resolution larger than the plan's
+    clearance: CLEARANCE_BELOW_REQUIRED, and without radii the gap is the clearance
+    (it read 0.0, 'touching', before).
+    """
+    from planner_helpers import CONFIGURATIONS
+    from punctured_planner_interfaces.srv import PlanSequence
+    far = [list(map(list, configuration)) for configuration in CONFIGURATIONS]
+    far[1][2][0] = 1e15
+    outcome = PlanSequenceHandler().handle(
+        make_request(far), PlanSequence.Response(),
+        snapshot(obstacles=[v for o in OBSTACLES for v in o]), 0)
+    response = outcome.response
+    assert response.error_code == PlanSequence.Response.CLEARANCE_BELOW_REQUIRED
+    assert 'numerical resolution' in response.error_msg
+    assert response.min_gap == response.min_clearance > 0.0
+
+
+def test_stamps_past_2038_name_the_limit_that_binds():
+    """A motion too long for the stamps under a tiny max_acceleration says to raise that."""
+    from punctured_planner_interfaces.srv import PlanSequence
+    flat = [v for o in OBSTACLES for v in o]
+    for max_acceleration, culprit in ((1e-20, 'raise max_acceleration'),
+                                      (0.0, 'raise max_speed')):
+        outcome = PlanSequenceHandler().handle(
+            make_request(max_speed=1e-12 if max_acceleration == 0.0 else 1.0),
+            PlanSequence.Response(),
+            snapshot(obstacles=flat, max_acceleration=max_acceleration), 0)
+        assert outcome.response.error_code == PlanSequence.Response.INVALID_REQUEST
+        assert outcome.response.error_msg.endswith(culprit), outcome.response.error_msg
+
+
 def test_array_holding_dataclasses_compare_by_identity():
     """Frame, ObstacleSet, RobotState, PlaneView: == and hash work (no numpy ValueError)."""
     from punctured_planner.core import Workspace

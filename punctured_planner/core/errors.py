@@ -193,7 +193,8 @@ class PlanningError(ValueError):
         self.coordinate = coordinate
         self.point = point
         # The refused plan's Clearance certificates, centre distance and surface gap
-        # (CLEARANCE_BELOW_REQUIRED only; gap None where rounding left it untrusted).
+        # (CLEARANCE_BELOW_REQUIRED only; as found, also where the clearance is below the
+        # coordinates' resolution).
         self.clearance = clearance
         self.gap = gap
         self.wall = wall

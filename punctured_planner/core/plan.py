@@ -443,7 +443,7 @@ def _check_required_clearance(result: Plan) -> None:
         f'{{next_waypoint}}) at tau {certificate.tau:.6g}',
         configuration=segment, robots=[a] if certificate.kind == 'obstacle' else [a, b],
         obstacle=b if certificate.kind == 'obstacle' else None, clearance=result.clearance,
-        gap=result.gap if trusted else None)
+        gap=result.gap)
 
 
 def _check_inside(result: Plan) -> None:

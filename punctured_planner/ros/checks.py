@@ -173,18 +173,30 @@ def check_poses(settings: PlannerSettings, robot_count: int, breakpoints: int,
                                                     settings.max_poses))
 
 
-def check_duration(duration: float, max_speed: float, start_ns: int) -> None:
+def check_duration(duration: float, at_speed_alone: float, max_speed: float,
+                   max_acceleration: float, start_ns: int) -> None:
     """
     INVALID_REQUEST when the motion's stamps do not fit builtin_interfaces/Time.
 
     Time and Duration carry int32 seconds: the last stamp must come before
     2038-01-19 and the duration must stay below 2^31 s. Known only once the
-    plan's length is, so checked after planning.
+    plan's length is, so checked after planning. The message names the limit to
+    raise: max_acceleration where the motion at max_speed alone (at_speed_alone)
+    would fit.
     """
-    if not (math.isfinite(duration) and start_ns + duration * 1e9 < _LAST_STAMP_NS):
-        fail(ErrorCode.INVALID_REQUEST, 'the motion would last %.6g s at max_speed %.6g '
-             'm/s: its stamps would pass the largest builtin_interfaces/Time '
-             '(2038-01-19T03:14:07Z); raise max_speed' % (duration, max_speed))
+    def fits(seconds: float) -> bool:
+        return math.isfinite(seconds) and start_ns + seconds * 1e9 < _LAST_STAMP_NS
+
+    if fits(duration):
+        return
+    if max_acceleration > 0 and fits(at_speed_alone):
+        limits, culprit = ('max_speed %.6g m/s and max_acceleration %.6g m/s^2'
+                           % (max_speed, max_acceleration), 'max_acceleration')
+    else:
+        limits, culprit = 'max_speed %.6g m/s' % max_speed, 'max_speed'
+    fail(ErrorCode.INVALID_REQUEST, 'the motion would last %.6g s at %s: its stamps would '
+         'pass the largest builtin_interfaces/Time (2038-01-19T03:14:07Z); raise %s'
+         % (duration, limits, culprit))
 
 
 def check(gathered: Gathered, snapshot: Snapshot) -> Checked:

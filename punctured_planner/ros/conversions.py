@@ -158,13 +158,26 @@ def to_xyz(points: npt.ArrayLike, plane_z: float = 0.0) -> np.ndarray:
     return xyz
 
 
+# Norms between these come from squares that neither overflow nor lose precision below
+# the smallest normal float.
+_SQUARES_SAFE = (1e-150, 1e150)
+
+
 def normalized_quaternions(quaternions: npt.ArrayLike) -> np.ndarray:
     """Return (..., 4) quaternions normalised; zero-length or non-finite ones -> identity."""
     quaternions = np.asarray(quaternions, dtype=float)
-    with np.errstate(invalid='ignore', over='ignore'):
+    with np.errstate(invalid='ignore', over='ignore', under='ignore'):
         # np.linalg.norm's own sum of squares, without its Python wrapper (a request's
-        # orientations are a few dozen values)
+        # orientations are a few dozen values): a unit quaternion comes back bit for bit.
         norms = np.sqrt(np.add.reduce(quaternions * quaternions, axis=-1, keepdims=True))
+        # A finite one whose squares overflow (1e200) or underflow (1e-170) is scaled by
+        # its largest component first, not taken for a non-finite or zero one.
+        extreme = ~((norms > _SQUARES_SAFE[0]) & (norms < _SQUARES_SAFE[1]))
+        largest = np.abs(quaternions).max(axis=-1, keepdims=True)
+        scale = np.where(extreme & (largest > 0) & np.isfinite(largest), largest, 1.0)
+        quaternions = quaternions / scale
+        norms = np.where(extreme, np.sqrt(np.add.reduce(quaternions * quaternions, axis=-1,
+                                                        keepdims=True)), norms)
         good = np.isfinite(norms) & (norms > 0)
         result = np.where(good, quaternions / np.where(good, norms, 1.0), IDENTITY)
     return result
