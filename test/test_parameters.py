@@ -158,10 +158,21 @@ def test_a_nodes_parameter_files_are_checked_together(tmp_path):
     # renamed, its sections carry the new name: not checked
     for rename in ('__node:=fleet_planner', 'planner_node:__node:=fleet_planner'):
         PLANNER.check_files(['--ros-args', '-r', rename, '--params-file', str(others)])
-    # rcl's nested form may name the node: not refused
+    # rcl's nested form is read as the name it spells: its values (as the node takes
+    # them under a namespace), its typos, and other nodes' sections alone refused
     nested = tmp_path / 'nested.yaml'
     nested.write_text('fleet:\n  planner_node:\n    ros__parameters: {max_speed: 2.0}\n')
     PLANNER.check_files(['--ros-args', '--params-file', str(nested)])
+    assert load_parameter_file(str(nested), PLANNER) == {'max_speed': 2.0}
+    nested.write_text('fleet:\n  planner_node:\n    ros__parameters: {max_sped: 2.0}\n')
+    with pytest.raises(InvalidParameterFile, match="unknown parameter 'max_sped'"):
+        PLANNER.check_files(['--ros-args', '--params-file', str(nested)])
+    nested.write_text('fleet:\n  plan_executor:\n    ros__parameters: {gain: 1.0}\n'
+                      '  "**":\n    ros__parameters: {max_speed: 3.0, gain: 1.0}\n')
+    assert load_parameter_file(str(nested), PLANNER) == {'max_speed': 3.0}
+    nested.write_text('fleet:\n  plan_executor:\n    ros__parameters: {gain: 1.0}\n')
+    with pytest.raises(InvalidParameterFile, match='no section applies to planner_node'):
+        PLANNER.check_files(['--ros-args', '--params-file', str(nested)])
 
 
 @pytest.mark.parametrize('table, values, words', [

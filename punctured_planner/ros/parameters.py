@@ -22,6 +22,7 @@ from typing import Any
 from typing import Callable
 from typing import Generic
 from typing import Iterable
+from typing import Iterator
 from typing import Sequence
 from typing import TypeVar
 
@@ -450,7 +451,7 @@ class FileValues:
     """One node's values from a parameter file, and whether any section of it applies."""
 
     values: dict
-    applies: bool   # a section names the node, /**, or rcl's nested form may (ns: {node: })
+    applies: bool   # a section names the node or /** (also nested: ns: {node: })
 
 
 def load_parameter_file(path: str, table: Table) -> dict:
@@ -471,6 +472,21 @@ def _no_section(table: Table) -> str:
     return 'no section applies to %s (/** or %s)' % (table.node_name, table.node_name)
 
 
+def _sections(data: dict, prefix: str = '') -> Iterator[tuple[str, Any]]:
+    """
+    Yield (name, section) of a parameter file's mapping, nested namespaces joined by '/'.
+
+    A mapping without ros__parameters is a namespace (rcl's nested form); anything else
+    is a node's section (or a malformed one, for its reader to refuse).
+    """
+    for key, section in data.items():
+        name = prefix + str(key)
+        if isinstance(section, dict) and section and 'ros__parameters' not in section:
+            yield from _sections(section, name.rstrip('/') + '/')
+        else:
+            yield name, section
+
+
 def read_parameter_file(path: str, table: Table) -> FileValues:
     """
     Return one node's parameter values from a ROS 2 parameter YAML file.
@@ -480,9 +496,10 @@ def read_parameter_file(path: str, table: Table) -> FileValues:
     declares, a ``/**`` section gives only the table's parameters (the others are
     other nodes'), and rclpy's own (use_sim_time) are left out; a name the node's
     own section sets and the table lacks is kept (settings() refuses it: a typo).
-    rcl's nested form (a namespace mapping to node sections) is not read, but counts
-    as possibly applying. Raises InvalidParameterFile for a file that is not a ROS
-    parameter file.
+    rcl's nested form (a namespace mapping to node sections, ``robots: {planner_node:
+    {ros__parameters: ...}}``) is read as the name it spells (robots/planner_node),
+    a namespace's ``**`` as ``/**``. Raises InvalidParameterFile for a file that is not
+    a ROS parameter file.
     """
     with open(path, encoding='utf-8') as stream:
         data = yaml.safe_load(stream) or {}
@@ -491,12 +508,10 @@ def read_parameter_file(path: str, table: Table) -> FileValues:
                                    'names)' % path)
     values: dict = {}
     applied = False
-    for key, section in data.items():
-        key = str(key)
-        shared = key in ('/**', '**')
-        if not shared and key.rstrip('/').split('/')[-1] != table.node_name:
-            nested = isinstance(section, dict) and 'ros__parameters' not in section
-            applied = applied or nested
+    for key, section in _sections(data):
+        last = key.rstrip('/').split('/')[-1]
+        shared = last == '**'
+        if not shared and last != table.node_name:
             continue
         applied = True
         if not isinstance(section, dict) or 'ros__parameters' not in section:
