@@ -15,6 +15,8 @@ would publish it.
 
 import argparse
 from collections.abc import Sequence
+import contextlib
+import math
 import os
 import sys
 import time
@@ -57,6 +59,17 @@ def ros_name(text: str) -> str:
         raise argparse.ArgumentTypeError('%r is not a valid ROS name: %s'
                                          % (text, str(error).split(', at ')[0]))
     return text
+
+
+def positive_float(text: str) -> float:
+    """Return text as a finite float > 0, or raise argparse.ArgumentTypeError."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'{text!r} is not a number')
+    if not 0 < value < math.inf:
+        raise argparse.ArgumentTypeError(f'{text!r} is not a positive finite number')
+    return value
 
 
 def load_request(path: str) -> Any:
@@ -236,9 +249,9 @@ def _plan(args):
     if outcome.ok:
         title = os.path.basename(args.request) if args.request != '-' else None
         try:
-            written = render_outputs(args, outcome.planned().plan, title=title,
-                                     max_speed=outcome.max_speed,
-                                     max_acceleration=outcome.max_acceleration)
+            written.extend(render_outputs(args, outcome.planned().plan, title=title,
+                                          max_speed=outcome.max_speed,
+                                          max_acceleration=outcome.max_acceleration))
             if args.mcap:
                 written.append(record_plan(args.mcap, outcome, settings))
         except OSError as error:  # the plan is printed all the same
@@ -269,9 +282,9 @@ def make_parser(pictures: bool = True) -> argparse.ArgumentParser:
     call.add_argument('request', help="YAML request file, '-' for standard input")
     call.add_argument('--service', default='/plan_sequence', type=ros_name,
                       help='service name (default: %(default)s)')
-    call.add_argument('--wait', type=float, default=10.0,
+    call.add_argument('--wait', type=positive_float, default=10.0,
                       help='seconds to wait for the service to appear (default: %(default)s)')
-    call.add_argument('--timeout', type=float, default=60.0,
+    call.add_argument('--timeout', type=positive_float, default=60.0,
                       help='seconds to wait for the response (default: %(default)s)')
     call.add_argument('--no-paths', action='store_true',
                       help='print only the number of paths, not the poses')
@@ -281,7 +294,7 @@ def make_parser(pictures: bool = True) -> argparse.ArgumentParser:
         "that came on the 'obstacles' topic")
     reset.add_argument('--node', default='/planner_node', type=ros_name,
                        help='the planner node (default: %(default)s)')
-    reset.add_argument('--wait', type=float, default=10.0,
+    reset.add_argument('--wait', type=positive_float, default=10.0,
                        help='seconds to wait for the node (default: %(default)s)')
     reset.set_defaults(func=_reset)
     plan = commands.add_parser(
@@ -317,6 +330,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         # Standard output goes to /dev/null so the flush at exit cannot fail again.
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return EXIT_BROKEN_PIPE
+    except OSError as error:  # standard output cannot be written (a full disk), or else
+        with contextlib.suppress(OSError):  # nor, perhaps, standard error
+            print('punctured-planner: %s' % error, file=sys.stderr)
+        try:
+            sys.stdout.flush()
+        except OSError:  # then the flush at exit would fail again: it goes to /dev/null
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_USAGE
 
 
 if __name__ == '__main__':

@@ -111,11 +111,11 @@ class Recorder:
         return spin_until(self.executor, predicate, timeout_sec)
 
 
-def _run(recorder, request_path, mcap_path, gif_path, fleet):
+def _run(recorder, request, mcap_path, gif_path, fleet):
     """
-    Plan and execute; write the recording and the GIF; return the exit code.
+    Plan request and execute the plan; write the recording and the GIF; return the exit code.
 
-    fleet is fleet_sim's parameter section (speed limit and factors).
+    fleet is fleet_sim's settings (speed limit and factors).
     """
     from punctured_planner_interfaces.action import ExecutePlan
     from punctured_planner_interfaces.srv import PlanSequence
@@ -126,7 +126,6 @@ def _run(recorder, request_path, mcap_path, gif_path, fleet):
     from .ros.client import FEEDBACK_SILENCE_SEC
     from .ros.client import GoalWatch
     from .ros.client import wait_for_result
-    from .ros.msg_dict import fill_message
     from .ros.qos import CLIENT_QOS
     node = recorder.node
     client = node.create_client(PlanSequence, 'plan_sequence', qos_profile=CLIENT_QOS)
@@ -135,8 +134,6 @@ def _run(recorder, request_path, mcap_path, gif_path, fleet):
             and recorder.spin(lambda: len(recorder.odometry) == len(recorder.names), 30)):
         print('demo: the nodes did not come up', file=sys.stderr)
         return 1
-    with open(request_path, encoding='utf-8') as stream:
-        request = fill_message(PlanSequence.Request(), yaml.safe_load(stream))
     response = call_service(recorder.executor, client, request, 30)
     deadline = time.monotonic() + 10
     while (response is not None and response.error_code == PlanSequence.Response.NO_ROBOT_STATE
@@ -199,14 +196,13 @@ def _print_ratios(recorder, executed, fleet):
     """
     from .core.timing import stamps
     from .ros import conversions
-    from .ros.settings import FleetSimSettings
     # the latched plan may reach this late-joined subscriber after the goal's result
     recorder.spin(lambda: any(h.topic == PLAN_TOPIC for h in recorder.messages), 10)
     plan = next(h.message for h in recorder.messages if h.topic == PLAN_TOPIC)
     reference = conversions.plan_reference(plan)
-    factors = np.asarray(fleet.get('speed_factors') or [1.0] * reference.robot_count)
+    factors = np.asarray(fleet.speed_factors or [1.0] * reference.robot_count)
     slowest = int(np.argmin(factors))
-    speed = float(fleet.get('speed_limit', FleetSimSettings.speed_limit)) * factors[slowest]
+    speed = fleet.speed_limit * factors[slowest]
     straight = np.linalg.norm(reference.positions[-1] - reference.positions[0], axis=1)
     bound = float(straight[slowest]) / speed
     retimed = float(stamps(reference.positions, plan.max_speed * factors[slowest],
@@ -294,11 +290,19 @@ def main(argv: Sequence[str] | None = None) -> int:
         folder = os.path.dirname(os.path.abspath(path))
         if not os.path.isdir(folder):
             parser.error('cannot write %s: no folder %s' % (path, folder))
+    from .cli import build_request
+    from .cli import load_request
+    from .ros.parameters import load_parameter_file
+    from .ros.settings import FLEET_SIM
+    try:  # before any node starts: a bad file is said at once, not after they came up
+        fleet = FLEET_SIM.settings(load_parameter_file(args.params, FLEET_SIM))
+    except (OSError, yaml.YAMLError, ValueError) as error:
+        parser.error('--params %s: %s' % (args.params, error))
+    try:
+        request = build_request(load_request(args.request))
+    except (OSError, yaml.YAMLError, ValueError) as error:
+        parser.error('--request %s: %s' % (args.request, error))
     os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
-    with open(args.params, encoding='utf-8') as stream:
-        values = yaml.safe_load(stream)
-    names = values['/**']['ros__parameters']['robot_names']
-    fleet = values.get('/**/fleet_sim', {}).get('ros__parameters', {})
     logs = tempfile.mkdtemp(prefix='punctured_planner_demo_')
     bin_dir = os.path.dirname(sys.executable)
     params = args.params if args.drive is None else _with_drive(args.params, args.drive, logs)
@@ -312,8 +316,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     code = 1
     try:
         with session('demo', namespace='/demo') as ros:
-            code = _run(Recorder(ros.node, ros.executor, names), args.request, args.mcap,
-                        args.gif, fleet)
+            code = _run(Recorder(ros.node, ros.executor, list(fleet.robot_names)), request,
+                        args.mcap, args.gif, fleet)
     except KeyboardInterrupt:
         print('demo: interrupted')
     finally:

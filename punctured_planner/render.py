@@ -11,11 +11,12 @@ command of ``punctured-planner`` gets ``--png``/``--gif`` with two lines::
 """
 
 import argparse
+from collections.abc import Iterator
 from collections.abc import Sequence
-import math
 import os
 import sys
 
+from .cli import positive_float
 from .core import Plan
 from .viz import domain_picture, example_plan, render_animation, render_png
 from .viz.animation import MAX_FPS, MAX_SECONDS
@@ -24,21 +25,10 @@ from .viz.animation import MAX_FPS, MAX_SECONDS
 MIN_DPI, MAX_DPI = 10, 1000
 
 
-def _positive_float(text):
-    """Return text as a finite float > 0, or raise argparse.ArgumentTypeError."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f'{text!r} is not a number')
-    if not 0 < value < math.inf:
-        raise argparse.ArgumentTypeError(f'{text!r} is not a positive finite number')
-    return value
-
-
 def _at_most(high):
     """Return an argparse type: a positive finite float at most high."""
     def value_of(text):
-        value = _positive_float(text)
+        value = positive_float(text)
         if value > high:
             raise argparse.ArgumentTypeError(f'{text!r} is more than {high:g}')
         return value
@@ -47,7 +37,7 @@ def _at_most(high):
 
 def _dpi(text):
     """Return text as a resolution in [MIN_DPI, MAX_DPI], or raise argparse.ArgumentTypeError."""
-    value = _positive_float(text)
+    value = positive_float(text)
     if not MIN_DPI <= value <= MAX_DPI:
         raise argparse.ArgumentTypeError(f'{text!r} is not in [{MIN_DPI}, {MAX_DPI}] dots per '
                                          'inch (1e-3 drew an empty image, 1e5 ran out of memory)')
@@ -88,18 +78,19 @@ def add_render_arguments(parser: argparse.ArgumentParser) -> argparse._ArgumentG
 
 def render_outputs(args: argparse.Namespace, plan: Plan, title: str | None = None,
                    max_speed: float = 1.0,
-                   max_acceleration: float = 0.0) -> list[str | os.PathLike[str]]:
-    """Write the pictures asked for by add_render_arguments' options; return their paths."""
-    written: list[str | os.PathLike[str]] = []
+                   max_acceleration: float = 0.0) -> Iterator[str | os.PathLike[str]]:
+    """
+    Write the pictures asked for by add_render_arguments' options; yield each path written.
+
+    One at a time, so a caller whose second file cannot be written still knows the first.
+    """
     if getattr(args, 'png', None):
-        written.append(render_png(plan, args.png, title=title, dpi=args.dpi,
-                                  raw=getattr(args, 'raw', False)))
+        yield render_png(plan, args.png, title=title, dpi=args.dpi,
+                         raw=getattr(args, 'raw', False))
     if getattr(args, 'gif', None):
-        written.append(render_animation(plan, args.gif, fps=args.gif_fps,
-                                        seconds=args.gif_seconds, dpi=args.gif_dpi,
-                                        title=title, max_speed=max_speed,
-                                        max_acceleration=max_acceleration))
-    return written
+        yield render_animation(plan, args.gif, fps=args.gif_fps, seconds=args.gif_seconds,
+                               dpi=args.gif_dpi, title=title, max_speed=max_speed,
+                               max_acceleration=max_acceleration)
 
 
 def _domain(args):
@@ -110,10 +101,9 @@ def _domain(args):
 
 def _example(args):
     """Draw the example plan."""
-    paths = render_outputs(args, example_plan(args.variant), title='example scenario')
-    for path in paths:
+    for path in render_outputs(args, example_plan(args.variant), title='example scenario'):
         print(path)
-    return 0 if paths else 2
+    return 0
 
 
 def make_parser() -> argparse.ArgumentParser:
@@ -122,7 +112,7 @@ def make_parser() -> argparse.ArgumentParser:
                                      description='Draw pictures of the planner.')
     commands = parser.add_subparsers(dest='command', required=True)
     domain = commands.add_parser('domain', help='the domain picture (PNG)')
-    domain.add_argument('output', metavar='OUT.png')
+    domain.add_argument('output', metavar='OUT.png', type=_file_of('.png', 'the picture'))
     domain.add_argument('--robots', type=int, choices=(1, 2), default=1,
                         help='number of robots (default: %(default)s)')
     domain.add_argument('--dpi', type=_dpi, default=100.0,
@@ -137,9 +127,16 @@ def make_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run ``python -m punctured_planner.render``; return the exit status."""
-    args = make_parser().parse_args(argv)
-    return args.func(args)
+    """Run ``python -m punctured_planner.render``; return the exit status (2: nothing drawn)."""
+    parser = make_parser()
+    args = parser.parse_args(argv)
+    if args.command == 'example' and not (args.png or args.gif):
+        parser.error('example: give --png OUT.png and/or --gif OUT.gif')
+    try:
+        return args.func(args)
+    except OSError as error:
+        print('%s: cannot write: %s' % (parser.prog, error), file=sys.stderr)
+        return 2
 
 
 if __name__ == '__main__':

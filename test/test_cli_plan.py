@@ -77,13 +77,20 @@ def test_plan_refusals_and_exit_codes(capsys, tmp_path):
                       '- poses: [{position: {x: 1.0, y: 0.0, z: 0.0}}]\n', encoding='utf-8')
     code, data, err = run(capsys, 'plan', str(lonely), '--no-paths')
     assert code == 0 and data['min_gap'] == data['tracking_tolerance'] == float('inf'), data
-    # a service or node name rclpy refuses: a usage error naming it (a traceback, exit 1)
-    for argv in (['call', EXAMPLE, '--service', 'bad name!'],
-                 ['reset-obstacles', '--node', 'bad name!']):
+    # a service or node name rclpy refuses: a usage error naming it (a traceback, exit 1);
+    # a time that is no positive number (nan: a traceback; 0, -1: the request was sent)
+    for argv, words in ((['call', EXAMPLE, '--service', 'bad name!'],
+                         "'bad name!' is not a valid ROS name"),
+                        (['reset-obstacles', '--node', 'bad name!'],
+                         "'bad name!' is not a valid ROS name"),
+                        (['call', EXAMPLE, '--timeout', 'nan'], 'not a positive finite'),
+                        (['call', EXAMPLE, '--timeout', '0'], 'not a positive finite'),
+                        (['call', EXAMPLE, '--wait', '-5'], 'not a positive finite'),
+                        (['reset-obstacles', '--wait', 'nan'], 'not a positive finite')):
         with pytest.raises(SystemExit) as usage:
             main(argv)
         assert usage.value.code == 2
-        assert "'bad name!' is not a valid ROS name" in capsys.readouterr().err
+        assert words in capsys.readouterr().err
 
 
 def test_plan_png_and_mcap_from_the_console_script(tmp_path, ros_env):
@@ -151,6 +158,30 @@ def test_plan_gif(capsys, tmp_path, option):
                        str(out), '--gif-seconds', '1', '--gif-fps', '4', '--gif-dpi', '40')
     assert code == 0, err
     assert out.read_bytes()[:6] in (b'GIF89a', b'GIF87a')
+
+
+def test_the_demo_refuses_its_files_before_starting_a_node(capsys, tmp_path):
+    """A missing request or a parameter file without fleet_sim: a usage error, no node run."""
+    from punctured_planner.demo import main as demo
+    for argv, words in ((['--request', str(tmp_path / 'missing.yaml')],
+                         '--request %s: [Errno 2]' % (tmp_path / 'missing.yaml')),
+                        (['--params', SCENARIO], 'no section applies to fleet_sim')):
+        with pytest.raises(SystemExit) as usage:
+            demo(argv + ['--mcap', str(tmp_path / 'd.mcap'), '--gif', str(tmp_path / 'd.gif')])
+        assert usage.value.code == 2
+        err = capsys.readouterr()
+        assert words in err.err and 'started' not in err.out, err
+
+
+def test_an_answer_that_cannot_be_written_is_said_so(tmp_path):
+    """Standard output on a full disk: a one-line reason and exit 2 (a traceback and 1)."""
+    with open('/dev/full', 'wb') as full:  # Linux's always-full device
+        process = subprocess.run([venv_script('punctured-planner'), 'plan', EXAMPLE,
+                                  '--params', SCENARIO, '--no-paths'],
+                                 stdout=full, stderr=subprocess.PIPE, timeout=120)
+    err = process.stderr.decode()
+    assert process.returncode == 2, err
+    assert 'No space left on device' in err and 'Traceback' not in err, err
 
 
 def test_a_reader_that_goes_away_ends_the_output_quietly(tmp_path):

@@ -130,6 +130,15 @@ def test_render_animation_lasts_its_seconds_and_passes_every_breakpoint(tmp_path
         image.seek(0)
         first = np.asarray(image.convert('RGB'))
     assert abs(sum(durations) - 2000) <= 12 * 10
+    # GIF keeps whole centiseconds: at 40 fps a frame is 20 ms, so 100 frames make 2 s
+    # (80 frames of 25 ms were stored as 20 ms each: 1.6 s)
+    render_animation(p, path, fps=40, seconds=2, dpi=20)
+    with Image.open(path) as image:
+        durations = []
+        for frame in range(image.n_frames):
+            image.seek(frame)
+            durations.append(image.info['duration'])
+    assert sum(durations) == 2000
     assert np.any(first != last)
     with pytest.raises(ValueError, match='fps must be in'):
         render_animation(p, tmp_path / 'fast.gif', fps=100, seconds=1)
@@ -234,9 +243,17 @@ def test_command_line_and_wiring(tmp_path, capsys):
     add_render_arguments(parser)
     args = parser.parse_args(['--png', str(tmp_path / 'p.png'), '--gif', str(tmp_path / 'p.gif'),
                               '--gif-fps', '4', '--gif-seconds', '1', '--dpi', '60'])
-    written = render_outputs(args, example_plan())
+    written = list(render_outputs(args, example_plan()))
     assert written == [str(tmp_path / 'p.png'), str(tmp_path / 'p.gif')]
-    assert render_outputs(parser.parse_args([]), example_plan()) == []
+    assert list(render_outputs(parser.parse_args([]), example_plan())) == []
+    # refused with the reason: PNG bytes named .gif, nothing to draw, no such folder
+    with pytest.raises(SystemExit):
+        main(['domain', str(tmp_path / 'd.gif')])
+    with pytest.raises(SystemExit):
+        main(['example'])
+    assert 'give --png OUT.png and/or --gif OUT.gif' in capsys.readouterr().err
+    assert main(['domain', str(tmp_path / 'no' / 'd.png')]) == 2
+    assert 'cannot write: [Errno 2] no folder' in capsys.readouterr().err
     with pytest.raises(SystemExit):
         parser.parse_args(['--gif', 'out.mp4'])
     assert 'gif' in capsys.readouterr().err
@@ -250,3 +267,20 @@ def test_command_line_and_wiring(tmp_path, capsys):
         with pytest.raises(SystemExit):
             parser.parse_args(options)
         assert words in capsys.readouterr().err, options
+
+
+def test_an_output_is_written_whole_or_the_old_one_stays(tmp_path):
+    """A write that fails half way leaves the file that was there, and no part of the new."""
+    from punctured_planner.outputs import replacing
+    path = tmp_path / 'plan.png'
+    path.write_bytes(b'the good picture')
+    with pytest.raises(OSError):
+        with replacing(path) as part:
+            with open(part, 'wb') as stream:
+                stream.write(b'half of a')
+            raise OSError(27, 'File too large')
+    assert path.read_bytes() == b'the good picture'
+    assert sorted(p.name for p in tmp_path.iterdir()) == ['plan.png']
+    render_png(example_plan(), path, dpi=20)
+    assert path.read_bytes()[:8] == b'\x89PNG\r\n\x1a\n'
+    assert sorted(p.name for p in tmp_path.iterdir()) == ['plan.png']

@@ -29,6 +29,7 @@ import numpy as np
 
 from .settings import PlannerSettings
 from .snapshot import Outcome
+from ..outputs import replacing
 
 _SEPARATOR = '=' * 80
 _PRIMITIVES = {'bool', 'byte', 'char', 'float32', 'float64', 'int8', 'uint8', 'int16',
@@ -135,7 +136,7 @@ def write_mcap(path: str | os.PathLike[str], messages: Iterable[tuple[str, objec
 
     schemas = {}
     channels = {}
-    with open(path, 'wb') as stream:
+    with replacing(path) as part, open(part, 'wb') as stream:
         writer = Writer(stream)
         writer.start(profile=Profile.ROS2, library='punctured_planner')
         for sequence, (topic, message) in enumerate(messages):

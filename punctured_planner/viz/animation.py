@@ -16,7 +16,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Circle
 import numpy as np
 
-from .canvas import grab_frame, robot_colours, write_gif
+from .canvas import frame_centiseconds, grab_frame, robot_colours, write_gif
 from .geometry import plane_view
 from .picture import plan_figure, plan_title
 from ..core import Plan
@@ -114,7 +114,7 @@ def render_animation(plan: Plan, path: str | os.PathLike[str], fps: float = 20,
                      max_speed: float = 1.0,
                      max_acceleration: float = 0.0) -> str | os.PathLike[str]:
     """
-    Write the motion as an animated GIF at path (fps * seconds frames); return path.
+    Write the motion as an animated GIF at path, seconds long at about fps; return path.
 
     The static picture is drawn once; each frame redraws only the trails, the
     robots and the title over it (blitting), then Pillow, matplotlib's own GIF
@@ -126,7 +126,8 @@ def render_animation(plan: Plan, path: str | os.PathLike[str], fps: float = 20,
         raise ValueError(f'fps must be in (0, {MAX_FPS:g}] (a GIF frame lasts at least '
                          f'{1000 / MAX_FPS:g} ms) and seconds in (0, {MAX_SECONDS:g}]; got fps '
                          f'{fps:g}, seconds {seconds:g}')
-    tau, stamps = frame_parameters(plan, int(round(fps * seconds)), max_speed,
+    count = int(round(100.0 * seconds / frame_centiseconds(fps)))
+    tau, stamps = frame_parameters(plan, count, max_speed,
                                    max_acceleration)
     # The trails: every breakpoint and every frame, in order; frame f ends at ends[f].
     trail_tau = np.union1d(tau, plan.times)

@@ -16,6 +16,8 @@ from matplotlib.layout_engine import LayoutEngine
 import numpy as np
 from PIL import Image
 
+from ..outputs import replacing
+
 # Colours of a GIF's one palette, taken from its first frame.
 GIF_COLOURS = 96
 
@@ -47,9 +49,20 @@ def grab_frame(figure: Figure) -> Image.Image:
     return Image.fromarray(np.asarray(canvas.buffer_rgba())[..., :3].copy())
 
 
+def frame_centiseconds(fps: float) -> int:
+    """
+    Return how long a GIF frame lasts at about fps frames a second, in centiseconds.
+
+    GIF stores a frame's delay in whole centiseconds (at least 2 for every viewer):
+    25 ms became 20, so a GIF of 40 fps for 8 s lasted 6.4 s. Frames are counted
+    and spaced by this, so the GIF lasts as long as asked.
+    """
+    return max(2, int(round(100.0 / fps)))
+
+
 def write_gif(path: str | os.PathLike[str], frames: list[Image.Image], fps: float) -> None:
     """
-    Write frames as a looping GIF at path, fps frames a second.
+    Write frames as a looping GIF at path, each frame_centiseconds(fps) long.
 
     One palette for every frame (the first frame's colours, median cut) and no
     dithering: the figures are flat colours, which dithering would speckle and
@@ -58,5 +71,6 @@ def write_gif(path: str | os.PathLike[str], frames: list[Image.Image], fps: floa
     palette = frames[0].convert('RGB').quantize(colors=GIF_COLOURS,
                                                 method=Image.Quantize.MEDIANCUT)
     images = [image.quantize(palette=palette, dither=Image.Dither.NONE) for image in frames]
-    images[0].save(path, format='GIF', save_all=True, append_images=images[1:],
-                   duration=int(round(1000 / fps)), loop=0)
+    with replacing(path) as part:
+        images[0].save(part, format='GIF', save_all=True, append_images=images[1:],
+                       duration=10 * frame_centiseconds(fps), loop=0)

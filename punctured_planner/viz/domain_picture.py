@@ -22,6 +22,7 @@ from .canvas import new_figure, robot_colours
 from .domains import snapped_axis, start_goal_grid, start_goal_specials, start_plane_grid
 from ..core import Workspace
 from ..core.complexity import domain_range, sequential_complexity
+from ..outputs import replacing
 
 TEACHING_OBSTACLES = [[-2.0, 0.0], [0.0, 0.0], [2.0, 0.0]]
 LIMIT = 4.5
@@ -135,5 +136,6 @@ def domain_picture(path: str | os.PathLike[str], robot_count: int = 1, resolutio
     figure.suptitle(f'Domains of continuity: {robots}, {r} obstacles on the x axis, n = 2: '
                     f'{high - low + 1} domains = TC_2 = {tc}; lower strata (lines, points) '
                     'drawn thickened', fontsize=10)
-    figure.savefig(path, dpi=dpi, format='png')
+    with replacing(path) as part:
+        figure.savefig(part, dpi=dpi, format='png')
     return path

@@ -10,7 +10,7 @@ and the smallest gap so far. Headless (Agg, Pillow), like the other pictures.
 from matplotlib.patches import Circle
 import numpy as np
 
-from .canvas import grab_frame, new_figure, robot_colours, write_gif
+from .canvas import frame_centiseconds, grab_frame, new_figure, robot_colours, write_gif
 
 
 def render_motion(path: str, seconds: np.ndarray, positions: np.ndarray,
@@ -45,7 +45,9 @@ def render_motion(path: str, seconds: np.ndarray, positions: np.ndarray,
         ax.add_patch(disc)
     heading = ax.set_title('')
     frames = []
-    shown = np.unique(np.r_[np.searchsorted(seconds, np.arange(0.0, seconds[-1], 1.0 / fps)),
+    # one frame per GIF frame's length (whole centiseconds), so the GIF runs in real time
+    every = frame_centiseconds(fps) / 100.0
+    shown = np.unique(np.r_[np.searchsorted(seconds, np.arange(0.0, seconds[-1], every)),
                             len(seconds) - 1])
     for t in shown.tolist():
         for i in range(k):

@@ -15,6 +15,7 @@ from .draw2d import draw_plan_2d, legend_handles
 from .draw3d import draw_plan_3d
 from .geometry import plane_view
 from ..core import Plan
+from ..outputs import replacing
 
 
 def clearance_text(plan: Plan) -> str:
@@ -95,5 +96,6 @@ def render_png(plan: Plan, path: str | os.PathLike[str], title: str | None = Non
                dpi: float = 100, raw: bool = False) -> str | os.PathLike[str]:
     """Draw the plan into a PNG file at path and return the path (raw: see plan_figure)."""
     figure, _ = plan_figure(plan, dpi=dpi, title=title, raw=raw)
-    figure.savefig(path, dpi=dpi, format='png')
+    with replacing(path) as part:
+        figure.savefig(part, dpi=dpi, format='png')
     return path
