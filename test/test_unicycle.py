@@ -210,6 +210,35 @@ def test_a_robot_made_holonomic_faces_x_again_and_moves_as_commanded():
     assert np.allclose(fleet.positions, [[0.05, 0.0, 0.0]])
 
 
+def test_a_robot_made_holonomic_while_driving_brakes_where_it_goes():
+    """Made holonomic at speed along +y and told to stop, it brakes along +y (it slid along +x)."""
+    fleet = fleet_of(np.zeros((1, 3)), [np.pi / 2], speed_limit=1.0, max_acceleration=1.0)
+    now = 0.0
+    for _ in range(100):
+        fleet.command(0, [0.5, 0.0, 0.0], now)
+        fleet.step(now, 0.01)
+        now += 0.01
+    fleet.configure(FleetSettings(speed_limit=1.0, max_acceleration=np.array([1.0])))
+    start = fleet.positions.copy()
+    for _ in range(100):
+        fleet.command(0, [0.0, 0.0, 0.0], now)
+        fleet.step(now, 0.01)
+        now += 0.01
+    moved = fleet.positions[0] - start[0]
+    assert abs(moved[0]) < 1e-9 and 0.1 < moved[1] < 0.15  # v^2 / 2a = 0.125 m along +y
+
+
+def test_a_differential_robot_on_a_reference_of_one_pose_finishes():
+    """A reference of one pose: the robot is there and finishes (the turns ahead raised)."""
+    reference = Reference(np.zeros(1), np.array([[[1.0, 1.0, 0.0]]]),
+                          np.array([[IDENTITY]]))
+    execution = Execution(reference, 0.2, ExecutionSettings(drive=('differential',)))
+    for _ in range(20):
+        step = execution.step(0.05, reference.position(0.0).copy(), np.zeros(1, dtype=bool))
+        assert np.all(step.velocities == 0.0) and np.all(step.yaw_rates == 0.0)
+    assert step.finished
+
+
 def test_commands_and_odometry_are_in_each_robots_body_frame():
     """The executor's commands and the simulator's odometry: rotated into each robot's frame."""
     step = Step(plan_time=0.0, rate=1.0, positions=np.zeros((2, 3)),

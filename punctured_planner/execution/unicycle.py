@@ -254,7 +254,7 @@ class Corners:
         its current one; where it stands still, the direction of its next move
         (0 if none) and the plan time that move starts (inf if none).
         """
-        k = self.speeds.shape[1] if self.speeds.size else 0
+        k = self.speeds.shape[1]  # (M - 1, k), also (0, k) for a reference of one pose
         if self.speeds.size == 0 or s >= self.seconds[-1]:
             return Upcoming(np.zeros((k, 3)), np.full(k, np.inf))
         j = int(leg_at(self.seconds, s))
@@ -281,7 +281,7 @@ class Corners:
         beyond REVERSE_ANGLE are stops (Execution): there only the creep corners
         are left to slow into.
         """
-        k = self.speeds.shape[1] if self.speeds.size else 0
+        k = self.speeds.shape[1]  # (M - 1, k), also (0, k) for a reference of one pose
         caps = np.ones(k)
         first = int(np.searchsorted(self.seconds, s, side='right'))
         last = int(np.searchsorted(self.seconds, s + LOOKAHEAD, side='right'))

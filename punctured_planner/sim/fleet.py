@@ -104,6 +104,7 @@ class Fleet:
         self._moves = np.zeros((k, 3))    # the last step's chords, differential robots
         self._ramped = np.zeros((k, 2))   # (forward, yaw rate) after the acceleration limits
         self._linear = np.zeros((k, 3))   # holonomic velocities after the acceleration limit
+        self.differential = np.zeros(k, dtype=bool)  # configure sets the drives
         self._pending: list[deque[Command]] = [deque() for _ in range(k)]
         self._active = Commanded(np.zeros((k, 3)), np.zeros(k))
         self._active_since = np.full(k, -np.inf)
@@ -128,12 +129,21 @@ class Fleet:
                               else np.asarray(settings.speed_factors, dtype=float))
         self.latencies = (np.zeros(k) if settings.latencies is None
                           else np.asarray(settings.latencies, dtype=float))
+        was_differential = self.differential
         self.differential = (np.zeros(k, dtype=bool) if settings.differential is None
                              else np.asarray(settings.differential, dtype=bool))
         # A robot made holonomic faces +x again, as its odometry's identity orientation
         # says: it kept its last heading, which the executor rotated its commands by, so a
         # command along +x drove it along -y.
         holonomic = ~self.differential
+        # and its ramp starts from the velocity it has (before its factor): the ramp had
+        # followed its body-frame commands, (forward, 0, 0), so told to stop while driving
+        # along +y it slid 0.12 m along +x
+        made_holonomic = was_differential & holonomic
+        factors = self.speed_factors[made_holonomic, None]
+        self._linear[made_holonomic] = np.divide(
+            self.velocities[made_holonomic], factors, where=factors > 0,
+            out=np.zeros_like(self.velocities[made_holonomic]))  # factor 0: it stands
         self.headings[holonomic] = self.yaw_rates[holonomic] = self.forward[holonomic] = 0.0
         self._ramped[holonomic] = 0.0
         self.accelerations = np.broadcast_to(
