@@ -30,29 +30,21 @@ SEEDS = range(3, 9)
 STEP = 0.05  # the executor's control period (s); the fleet steps at half of it
 
 
-def node_values(parameters: dict, node: str, table) -> dict:
-    """Return a node's parameters of a parameter file: the shared ones it has, then its own."""
-    shared = parameters.get('/**', {}).get('ros__parameters', {})
-    own = parameters.get('/**/' + node, {}).get('ros__parameters', {})
-    return {**{name: value for name, value in shared.items() if name in table.by_name}, **own}
-
-
 def demo_scene():
     """Return (Reference, Bodies, tolerance, FleetSettings, ExecutionSettings) of make demo."""
     from punctured_planner.cli import offline_plan
     from punctured_planner.ros import conversions
     from punctured_planner.ros.msg_dict import fill_message
+    from punctured_planner.ros.parameters import load_parameter_file
     from punctured_planner.ros.settings import EXECUTOR
     from punctured_planner.ros.settings import FLEET_SIM
     from punctured_planner.ros.settings import PLANNER
     from punctured_planner_interfaces.srv import PlanSequence
-    with open(os.path.join(CONFIG, 'demo.yaml'), encoding='utf-8') as stream:
-        parameters = yaml.safe_load(stream)
     with open(os.path.join(CONFIG, 'demo_request.yaml'), encoding='utf-8') as stream:
         request = yaml.safe_load(stream)
-    planner = PLANNER.settings(node_values(parameters, 'planner_node', PLANNER))
-    fleet = FLEET_SIM.settings(node_values(parameters, 'fleet_sim', FLEET_SIM))
-    executor = EXECUTOR.settings(node_values(parameters, 'plan_executor', EXECUTOR))
+    # each node's values as it reads the file (the shared section, then its own)
+    planner, fleet, executor = (table.settings(load_parameter_file(
+        os.path.join(CONFIG, 'demo.yaml'), table)) for table in (PLANNER, FLEET_SIM, EXECUTOR))
     start = np.reshape(fleet.initial_positions, (-1, 3))
     request['use_current_state'] = False
     request['configurations'].insert(0, {
