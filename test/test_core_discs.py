@@ -273,6 +273,28 @@ def test_overlapping_bodies_are_refused_naming_the_culprits(configuration, code,
     assert caught.value.configuration == 1
 
 
+def test_several_faults_report_the_smallest_code_then_the_first_configuration():
+    """
+    Overlapping discs (10) before an exact robot on a pillar (11); within a code, C_1 first.
+
+    The exact meetings were checked before the overlaps: a robot exactly on a pillar
+    in C_2 outranked overlapping discs in C_1, and robots at one point in C_3 discs
+    overlapping in C_1.
+    """
+    workspace = Workspace([[5.0, 5.0]], variant='discs', robot_radius=0.5)
+    overlapping, on_pillar = [[0.0, 0.0], [0.5, 0.0]], [[5.0, 5.0], [9.0, 0.0]]
+    at_one_point, good = [[1.0, 1.0], [1.0, 1.0]], [[0.0, 0.0], [3.0, 0.0]]
+    for configurations, code, configuration in (
+            ([overlapping, on_pillar], ErrorCode.ROBOTS_COINCIDE, 0),
+            ([good, overlapping, at_one_point], ErrorCode.ROBOTS_COINCIDE, 1),
+            ([good, at_one_point, overlapping], ErrorCode.ROBOTS_COINCIDE, 1),
+            ([good, [[4.7, 5.0], [0.0, 0.0]], on_pillar], ErrorCode.ROBOT_ON_OBSTACLE, 1),
+            ([good, on_pillar, [[4.7, 5.0], [0.0, 0.0]]], ErrorCode.ROBOT_ON_OBSTACLE, 1)):
+        with pytest.raises(PlanningError) as caught:
+            plan(workspace, configurations)
+        assert (caught.value.code, caught.value.configuration) == (code, configuration)
+
+
 def test_a_distance_an_ulp_short_of_its_bound_is_written_in_full():
     """Refused against 2R by an ulp: the message does not say 3.7 is less than 3.7."""
     workspace = Workspace([[10.0, 10.0]], variant='discs', robot_radius=1.85)

@@ -127,7 +127,17 @@ def test_caller_frame_that_cannot_separate_obstacles_is_refused():
     assert 'obstacles 0 and 1' in str(error.value)
     with pytest.raises(PlanningError) as error:
         Workspace([[0.0, 0.0]], frame=([0, 0], [1, 0], [1, 1]))
-    assert error.value.code == ErrorCode.INVALID_REQUEST
+    assert (error.value.code, error.value.option) == (ErrorCode.INVALID_REQUEST, 'frame')
+    # an origin beyond the coordinates' range: refused (its plan was NaN, certified inf)
+    for origin in ((1e308, 0.0), (1e16, 0.0)):
+        with pytest.raises(PlanningError) as error:
+            Workspace(np.zeros((0, 2)), variant='discs', frame=(origin, (1, 0), (0, 1)))
+        assert (error.value.code, error.value.option) == (ErrorCode.INVALID_REQUEST, 'frame')
+        assert 'supported range' in str(error.value)
+    # bounds refused name their option too
+    with pytest.raises(PlanningError) as error:
+        Workspace(np.zeros((0, 2)), bounds=[[1, -1], [-1, 1]])
+    assert (error.value.option, error.value.wall.name) == ('bounds', 'x_min')
 
 
 def test_caller_frame_is_used():

@@ -83,6 +83,17 @@ def test_zero_acceleration_keeps_todays_stamps_bit_for_bit(refine):
         assert np.array_equal(samples.values[:-1], inner.ravel())
 
 
+def test_limits_that_are_not_positive_and_finite_are_refused():
+    """An infinite acceleration (or speed) limit is refused, not stamped NaN."""
+    p = plan(Workspace(OBSTACLES, robot_radius=0.1, variant='discs'), DEMO)
+    for speed, acceleration in ((1.0, np.inf), (np.inf, 1.0), (np.inf, 0.0), (1.0, np.nan),
+                                (0.0, 1.0)):
+        with pytest.raises(ValueError, match='positive and finite'):
+            p.stamps(speed, acceleration)
+    with pytest.raises(ValueError, match='positive and finite'):
+        fleet_profile(p.positions, np.full(4, 1.0), np.full(4, np.inf), 0.1)
+
+
 polylines = st.tuples(st.integers(0, 2 ** 32 - 1), st.integers(2, 12), st.integers(1, 4),
                       st.sampled_from([0.0, 0.3, 1.0]))
 

@@ -16,6 +16,7 @@ from scipy.spatial import ConvexHull, QhullError
 
 from .certificate import RELATIVE_RESOLUTION
 from .errors import ErrorCode, literal, PlanningError
+from .limits import MAX_COORDINATE
 from .walls import box_corners
 
 _ORTHONORMAL_TOLERANCE = 1e-9
@@ -254,13 +255,20 @@ def checked_frame(frame: Frame | tuple, dimension: int) -> Frame:
     except (TypeError, ValueError):
         raise PlanningError(ErrorCode.INVALID_REQUEST,
                             f'frame must be a Frame or (origin, e1, e2), three '
-                            f'{dimension}-vectors of real numbers; got {literal(repr(frame))}'
-                            ) from None
+                            f'{dimension}-vectors of real numbers; got {literal(repr(frame))}',
+                            option='frame') from None
     if not (origin.size == e1.size == e2.size == dimension):
         raise PlanningError(ErrorCode.INVALID_REQUEST,
-                            f'frame vectors must have dimension {dimension}')
+                            f'frame vectors must have dimension {dimension}', option='frame')
+    # an origin beyond the coordinates' range (1e308) made every projection inf and the
+    # motion NaN, which the certificate took for an infinite gap
+    if not np.all(np.abs(origin) <= MAX_COORDINATE):
+        raise PlanningError(ErrorCode.INVALID_REQUEST,
+                            f'frame origin {origin.tolist()} must be finite and within the '
+                            f'supported range +-{MAX_COORDINATE:.0e}', option='frame')
     gram = np.array([[e1 @ e1, e1 @ e2], [e2 @ e1, e2 @ e2]])
-    if not (np.all(np.isfinite(gram)) and np.all(np.isfinite(origin))
+    if not (np.all(np.isfinite(gram))
             and np.allclose(gram, np.eye(2), atol=_ORTHONORMAL_TOLERANCE)):
-        raise PlanningError(ErrorCode.INVALID_REQUEST, 'frame e1, e2 must be orthonormal')
+        raise PlanningError(ErrorCode.INVALID_REQUEST, 'frame e1, e2 must be orthonormal',
+                            option='frame')
     return Frame(origin, e1, e2)

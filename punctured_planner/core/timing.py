@@ -63,8 +63,8 @@ def length_times(positions: np.ndarray, waypoint_indices: np.ndarray) -> np.ndar
 
 def breakpoint_stamps(positions: np.ndarray, max_speed: float) -> np.ndarray:
     """Return (V,) seconds from the start at which the robots reach each breakpoint."""
-    if not max_speed > 0:
-        raise ValueError('max_speed must be positive')
+    if not 0 < max_speed < np.inf:
+        raise ValueError('max_speed must be positive and finite')
     stamps = np.zeros(len(positions))
     np.add.accumulate(leg_lengths(positions) / max_speed, out=stamps[1:])
     return stamps
@@ -190,8 +190,8 @@ def speed_profile(positions: np.ndarray, max_speed: float, max_acceleration: flo
     jump / Delta, so no robot's velocity jumps by more than jump. A forward and
     a backward pass make every breakpoint speed reachable within its legs.
     """
-    if not (max_speed > 0 and max_acceleration > 0):
-        raise ValueError('max_speed and max_acceleration must be positive')
+    if not (0 < max_speed < np.inf and 0 < max_acceleration < np.inf):
+        raise ValueError('max_speed and max_acceleration must be positive and finite')
     lengths = leg_lengths(positions)
     speeds = _breakpoint_speeds(positions, lengths, np.full(len(lengths), float(max_speed)),
                                 np.full(len(lengths), float(max_acceleration)),
@@ -223,8 +223,9 @@ def fleet_profile(positions: np.ndarray, max_speeds: np.ndarray,
     """
     max_speeds = np.asarray(max_speeds, dtype=float)
     max_accelerations = np.asarray(max_accelerations, dtype=float)
-    if not (np.all(max_speeds > 0) and np.all(max_accelerations > 0)):
-        raise ValueError('every max_speed and max_acceleration must be positive')
+    if not (np.all((max_speeds > 0) & (max_speeds < np.inf))
+            and np.all((max_accelerations > 0) & (max_accelerations < np.inf))):
+        raise ValueError('every max_speed and max_acceleration must be positive and finite')
     lengths = leg_lengths(positions)
     steps = np.linalg.norm(np.diff(positions, axis=0), axis=2)
     with np.errstate(divide='ignore', invalid='ignore'):

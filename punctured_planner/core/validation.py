@@ -213,42 +213,54 @@ def validate_configurations(configurations: npt.ArrayLike, obstacles: np.ndarray
                             f'{{configuration}}, robot {robot}: coordinate {axis} is '
                             f'{checked[m, robot, axis]}', configuration=m, robots=[robot],
                             coordinate=axis)
-    coincident, on_obstacle = _coincidences(checked, obstacles)
-    if coincident is not None:
+    coincident, on_point = _coincidences(checked, obstacles)
+    if obstacle_radii is None:
+        obstacle_radii = np.zeros(len(obstacles))
+    overlap, on_obstacle = _first_overlap(checked, obstacles, robot_radius,
+                                          obstacle_radii)
+    # The smallest code first (robots before obstacles), and within it the first
+    # configuration, an exact meeting before an overlap there: an exact robot on an
+    # obstacle outranked overlapping discs, a meeting in C_3 an overlap in C_1.
+    robots = _first_of(coincident, overlap)
+    if robots is not None and robots is coincident:
         both = [coincident.first, coincident.second]
         raise PlanningError(ErrorCode.ROBOTS_COINCIDE,
                             f'{{configuration}}: robots {both[0]} and {both[1]} are at the same '
                             f'point {checked[coincident.configuration, both[0]].tolist()}',
                             configuration=coincident.configuration, robots=both)
-    if on_obstacle is not None:
-        raise PlanningError(ErrorCode.ROBOT_ON_OBSTACLE,
-                            f'{{configuration}}: robot {on_obstacle.first} is on {{obstacle}}',
-                            configuration=on_obstacle.configuration, robots=[on_obstacle.first],
-                            obstacle=on_obstacle.second,
-                            point=obstacles[on_obstacle.second].tolist())
-    if obstacle_radii is None:
-        obstacle_radii = np.zeros(len(obstacles))
-    overlap, on_obstacle = _first_overlap(checked, obstacles, robot_radius,
-                                          obstacle_radii)
-    if overlap is not None:
-        apart, least = compared(overlap.distance, 2 * robot_radius)
+    if robots is not None:  # the overlap
+        apart, least = compared(robots.distance, 2 * robot_radius)
         raise PlanningError(ErrorCode.ROBOTS_COINCIDE,
-                            f'{{configuration}}: the discs of robots {overlap.first} and '
-                            f'{overlap.second} overlap: centres {apart} apart, less than 2 '
-                            f'robot_radius = {least}', configuration=overlap.configuration,
-                            robots=[overlap.first, overlap.second])
-    if on_obstacle is not None:
-        obstacle = on_obstacle.second
-        apart, least = compared(on_obstacle.distance, robot_radius + obstacle_radii[obstacle])
+                            f'{{configuration}}: the discs of robots {robots.first} and '
+                            f'{robots.second} overlap: centres {apart} apart, less than 2 '
+                            f'robot_radius = {least}', configuration=robots.configuration,
+                            robots=[robots.first, robots.second])
+    touching = _first_of(on_point, on_obstacle)
+    if touching is not None and touching is on_point:
         raise PlanningError(ErrorCode.ROBOT_ON_OBSTACLE,
-                            f'{{configuration}}: robot {on_obstacle.first} overlaps '
+                            f'{{configuration}}: robot {on_point.first} is on {{obstacle}}',
+                            configuration=on_point.configuration, robots=[on_point.first],
+                            obstacle=on_point.second, point=obstacles[on_point.second].tolist())
+    if touching is not None:  # the overlap
+        obstacle = touching.second
+        apart, least = compared(touching.distance, robot_radius + obstacle_radii[obstacle])
+        raise PlanningError(ErrorCode.ROBOT_ON_OBSTACLE,
+                            f'{{configuration}}: robot {touching.first} overlaps '
                             f'{{obstacle}}: centres {apart} apart, less than robot_radius + '
                             f'obstacle_radius = {least}',
-                            configuration=on_obstacle.configuration, robots=[on_obstacle.first],
+                            configuration=touching.configuration, robots=[touching.first],
                             obstacle=obstacle, point=obstacles[obstacle].tolist())
     if bounds is not None:
         _reject_outside(checked, bounds, robot_radius)
     return checked
+
+
+def _first_of(exact: Meeting | None, overlap: Meeting | None) -> Meeting | None:
+    """Return the meeting in the earlier configuration, exact on a tie; None for none."""
+    if exact is None or (overlap is not None
+                         and overlap.configuration < exact.configuration):
+        return overlap
+    return exact
 
 
 def _reject_outside(configurations, bounds, robot_radius):

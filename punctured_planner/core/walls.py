@@ -70,28 +70,30 @@ def checked_bounds(bounds: npt.ArrayLike | None, dimension: int) -> np.ndarray |
         array = np.asarray(bounds, dtype=float)
     except (TypeError, ValueError):
         raise PlanningError(ErrorCode.INVALID_REQUEST,
-                            'bounds must be real numbers, [low, high] per axis') from None
+                            'bounds must be real numbers, [low, high] per axis',
+                            option='bounds') from None
     if array.shape != (dimension, 2):
         raise PlanningError(ErrorCode.INVALID_REQUEST,
                             f'bounds must have shape (d, 2) = ({dimension}, 2), one '
-                            f'[min, max] per axis; got shape {array.shape}')
+                            f'[min, max] per axis; got shape {array.shape}', option='bounds')
     bad = first_non_finite(array)
     if bad is not None:
         raise PlanningError(ErrorCode.INVALID_REQUEST,
                             f'bounds must be finite; {{wall}} is {array[bad]}',
-                            wall=Wall(bad[0], bool(bad[1])))
+                            wall=Wall(bad[0], bool(bad[1])), option='bounds')
     far = first_out_of_range(array)
     if far is not None:
         raise PlanningError(ErrorCode.INVALID_REQUEST,
                             f'bounds: {{wall}} = {array[far]:.6g} is beyond the supported range '
-                            f'+-{MAX_COORDINATE:.0e}', wall=Wall(far[0], bool(far[1])))
+                            f'+-{MAX_COORDINATE:.0e}', wall=Wall(far[0], bool(far[1])),
+                            option='bounds')
     empty = np.flatnonzero(~(array[:, 0] < array[:, 1]))
     if empty.size:
         axis = int(empty[0])
         raise PlanningError(ErrorCode.INVALID_REQUEST,
                             f'bounds: {{wall}} = {array[axis, 0]:.6g} must be below '
                             f'{Wall(axis, True).name} = {array[axis, 1]:.6g}',
-                            wall=Wall(axis, False))
+                            wall=Wall(axis, False), option='bounds')
     return array
 
 

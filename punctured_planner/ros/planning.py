@@ -55,6 +55,11 @@ def refuse_stopping(response: Any, node_name: str, number: int, configuration_co
         % (node_name, number, counted(configuration_count, 'configuration'), into_stop))
 
 
+# The Workspace option a core refusal names, as the node's parameter that sets it (the
+# others share their names).
+_PARAMETER_OF_OPTION = {'bounds': 'workspace_bounds'}
+
+
 class PlanSequenceHandler:
     """Answers PlanSequence requests; keeps the last few Workspaces (one per obstacle set)."""
 
@@ -169,8 +174,8 @@ class PlanSequenceHandler:
             # The parameters involved, those that changed first; the core's PlanningError
             # (code, obstacle, wall, option) stays as the cause.
             involved = {'obstacles'} if obstacles.from_parameter else set()
-            if error.option is not None:
-                involved.add(error.option)
+            if error.option is not None:  # the core's option is the parameter of its name
+                involved.add(_PARAMETER_OF_OPTION.get(error.option, error.option))
             if error.wall is not None:
                 involved.add('workspace_bounds')
             raise InvalidParameter(
