@@ -513,6 +513,96 @@ def test_a_goal_for_a_plan_that_is_no_plan_ends_at_once_saying_why(ros_client, l
         ros_client.node.destroy_publisher(publisher)
 
 
+def test_a_goal_starts_only_with_its_robots_at_rest(ros_client, lone_executor):
+    """
+    Robots at the plan's start whose odometry reports 0.3 m/s: the goal waits, then starts.
+
+    A goal that preempted a moving one started at once, its robots braking past a
+    reference that starts at rest (1.2 delta over DDS); robots that do not stop within
+    discovery_timeout end it NOT_AT_START, named with their speeds; settings changed
+    while it waits are checked when it starts.
+    """
+    from nav_msgs.msg import Odometry
+    from planner_helpers import faulty_plan
+    from punctured_planner.ros import conversions
+    from punctured_planner.ros.qos import LATCHED
+    from punctured_planner.ros.qos import STATE
+    from punctured_planner_interfaces.action import ExecutePlan
+    from punctured_planner_interfaces.msg import Plan
+    from rclpy.parameter import Parameter
+    from rclpy.parameter_client import AsyncParameterClient
+    executor, action = lone_executor
+    message = faulty_plan('none')
+    start = conversions.plan_reference(message).position(0.0)
+    node = ros_client.node
+    plans = node.create_publisher(Plan, executor.name('plan'), LATCHED)
+    odometry = {name: node.create_publisher(Odometry, executor.name(name + '/odom'), STATE)
+                for name in message.robot_names}
+    speed = [0.3]
+
+    def report():
+        for i, (name, publisher) in enumerate(odometry.items()):
+            msg = Odometry()
+            msg.header.frame_id = message.paths[0].header.frame_id
+            msg.pose.pose.position.x, msg.pose.pose.position.y = start[i, :2].tolist()
+            msg.pose.pose.orientation.w = 1.0
+            msg.twist.twist.linear.x = speed[0]
+            publisher.publish(msg)
+
+    timer = node.create_timer(0.05, report)
+    try:
+        plans.publish(message)
+        fed = []
+        sent = action.send_goal_async(ExecutePlan.Goal(plan_id=message.plan_id),
+                                      feedback_callback=fed.append)
+        assert ros_client.spin_until(sent.done, 10) and sent.result().accepted
+        ros_client.spin_until(lambda: False, 1.0)
+        assert fed == [], 'the goal started with its robots moving'
+        speed[0] = 0.0
+        assert ros_client.spin_until(lambda: fed, 10), executor.log()
+        sent.result().cancel_goal_async()
+        result = sent.result().get_result_async()
+        assert ros_client.spin_until(result.done, 10), executor.log()
+        # still moving after discovery_timeout: NOT_AT_START, the robots and speeds named
+        parameters = AsyncParameterClient(node, executor.name('plan_executor'))
+        assert parameters.wait_for_services(timeout_sec=10)
+        future = parameters.set_parameters([Parameter('discovery_timeout', value=0.5)])
+        assert ros_client.spin_until(future.done, 10)
+        assert all(r.successful for r in future.result().results), future.result()
+        speed[0] = 0.3
+        ros_client.spin_until(lambda: False, 0.5)  # the moving odometry before the goal
+        sent = action.send_goal_async(ExecutePlan.Goal(plan_id=message.plan_id))
+        assert ros_client.spin_until(sent.done, 10) and sent.result().accepted
+        result = sent.result().get_result_async()
+        assert ros_client.spin_until(result.done, 10), executor.log()
+        ended = result.result().result
+        assert ended.error_code == ExecutePlan.Result.NOT_AT_START, ended
+        assert 'still moving 0.5 s after the goal came: robot_0 at 0.300 m/s' in \
+            ended.error_msg, ended.error_msg
+        # drive changed to a count that does not fit while the goal waits: UNKNOWN_ROBOTS
+        # with the reason when it starts, as at its arrival (an internal error, 99, before)
+        future = parameters.set_parameters([Parameter('discovery_timeout', value=5.0)])
+        assert ros_client.spin_until(future.done, 10)
+        sent = action.send_goal_async(ExecutePlan.Goal(plan_id=message.plan_id))
+        assert ros_client.spin_until(sent.done, 10) and sent.result().accepted
+        future = parameters.set_parameters([Parameter('drive',
+                                                      value=['holonomic', 'differential'])])
+        assert ros_client.spin_until(future.done, 10)
+        assert all(r.successful for r in future.result().results), future.result()
+        speed[0] = 0.0
+        result = sent.result().get_result_async()
+        assert ros_client.spin_until(result.done, 10), executor.log()
+        ended = result.result().result
+        assert ended.error_code == ExecutePlan.Result.UNKNOWN_ROBOTS, ended
+        assert 'drive has 2 values for 4 robots' in ended.error_msg, ended.error_msg
+        assert 'Traceback' not in executor.log(), executor.log()
+    finally:
+        node.destroy_timer(timer)
+        node.destroy_publisher(plans)
+        for publisher in odometry.values():
+            node.destroy_publisher(publisher)
+
+
 def test_a_result_asked_for_after_a_cancel_at_a_stop_is_answered(ros_client, lone_executor):
     """
     A goal canceled and SIGINT at once, its result asked for after the cancel's reply: it comes.

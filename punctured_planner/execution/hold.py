@@ -1,8 +1,9 @@
 """
 When a goal may start, and when a hold of the plan clock ends it (doc/design.md section 13).
 
-A plan is certified from its start: a goal starts only with every robot within the
-tracking tolerance of its reference there (:func:`off_start`). The plan clock holds
+A plan is certified from its start, at rest: a goal starts only with every robot at rest
+(:func:`still_moving`) and within the tracking tolerance of its reference there
+(:func:`off_start`). The plan clock holds
 for stale odometry or for a robot that does not follow; one hold, whatever holds it,
 may last ``hold_timeout`` (:class:`ClockHold`): then the goal ends, for lost odometry
 if some robot's went stale during the hold, else for the robots the clock waits for
@@ -20,6 +21,18 @@ from .reference import Reference
 # without reaching it: the hold flickered and a goal with a stuck robot whose
 # odometry stayed fresh ran on for good (a DDS test, 1 run in 3 under load).
 HELD_RATE = 0.05
+
+
+# A robot whose odometry reports at most this speed (m/s) is at rest: stopping from it
+# takes millimetres. A goal that preempted a moving one started while its robots still
+# braked from 0.3 - 0.6 m/s, ran ahead of the new reference (which starts at rest, and
+# the clock does not wait for a robot ahead) and reached 1.2 delta (over DDS).
+AT_REST_SPEED = 0.05
+
+
+def still_moving(speeds: np.ndarray) -> np.ndarray:
+    """Return the indices of the robots not at rest: speed above AT_REST_SPEED, or NaN."""
+    return np.flatnonzero(~(np.asarray(speeds) <= AT_REST_SPEED))
 
 
 @dataclass(frozen=True)

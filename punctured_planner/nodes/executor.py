@@ -74,6 +74,7 @@ from ..execution.execution import leaving_their_plane
 from ..execution.execution import WrongCount
 from ..execution.hold import ClockHold
 from ..execution.hold import off_start
+from ..execution.hold import still_moving
 from ..execution.hold import waited_for
 from ..ros import conversions
 from ..ros.goals import fleet_state
@@ -437,16 +438,34 @@ class PlanExecutor(Node):
 
     def _start(self, run: Run, state: FleetState, now: int) -> Execution | None:
         """
-        Start the run's Execution once every robot reported; UNKNOWN_ROBOTS after a wait.
+        Start the run's Execution once every robot reported and is at rest.
 
+        UNKNOWN_ROBOTS, or NOT_AT_START for a robot still moving, after discovery_timeout;
+        the per-robot settings are checked again (they may have changed while it waited).
         Return the started Execution, or None while waiting (or once refused).
         """
         settings, plan = self._settings, run.plan
+        waited = now - run.requested_ns > settings.discovery_timeout * 1e9
         if state.stale:
-            if now - run.requested_ns > settings.discovery_timeout * 1e9:
+            if waited:
                 self._finish(run, Result.UNKNOWN_ROBOTS, 'no odometry within %g s from %s '
                              '(topics %s)' % (settings.discovery_timeout, ', '.join(state.stale),
                                               self._odometry_topics(state.stale)))
+            return None
+        # a goal that preempts a moving one waits for the robots to stop: its plan starts
+        # at rest
+        moving = still_moving(state.speeds)
+        if moving.size:
+            if waited:
+                self._finish(run, Result.NOT_AT_START, 'still moving %g s after the goal '
+                             'came: %s; plan %d starts at rest' % (
+                                 settings.discovery_timeout, ', '.join(
+                                     '%s at %.3f m/s' % (plan.names[i], state.speeds[i])
+                                     for i in moving), plan.plan_id))
+            return None
+        per_robot = self._check_per_robot(plan)
+        if per_robot.code != Result.NONE:  # drive, max_speeds or max_accelerations changed
+            self._finish(run, per_robot.code, per_robot.message)
             return None
         far = off_start(plan.reference, state.positions, plan.tolerance)
         if far.robots.size:

@@ -36,6 +36,7 @@ Conventions:
 from collections.abc import Iterable
 from collections.abc import Sequence
 from dataclasses import dataclass
+import math
 
 from builtin_interfaces.msg import Duration
 from builtin_interfaces.msg import Time
@@ -124,8 +125,10 @@ def odometry_pose(msg: Odometry) -> PoseValues:
 def robot_odometry(msg: Odometry, received_ns: int) -> RobotOdometry:
     """Return the RobotOdometry of a nav_msgs/Odometry message that arrived at received_ns."""
     pose = odometry_pose(msg)
+    linear = msg.twist.twist.linear
     return RobotOdometry(pose.position, pose.orientation, msg.header.frame_id,
-                         stamp_to_ns(msg.header.stamp), int(received_ns))
+                         stamp_to_ns(msg.header.stamp), int(received_ns),
+                         math.hypot(linear.x, linear.y, linear.z))
 
 
 def obstacles_from_parameter(values: npt.ArrayLike) -> np.ndarray:

@@ -165,7 +165,7 @@ class FleetState:
     positions (k, 3) and orientations (k, 4) (a stale robot keeps the plan's
     start and its last orientation heard, else the identity), the stale robots'
     names and (k,) mask, the (k,) ages of the odometry by arrival (s; 0 for a
-    stale robot) and
+    stale robot), the (k,) speeds its twists report (m/s; 0 for a stale robot) and
     ``wrong_frame``: the first robot whose odometry is in another frame than
     the plan's (None when none is).
     """
@@ -175,6 +175,7 @@ class FleetState:
     stale: tuple
     stale_mask: np.ndarray
     ages: np.ndarray
+    speeds: np.ndarray
     wrong_frame: WrongFrame | None = None
 
 
@@ -186,7 +187,7 @@ def fleet_state(plan: KnownPlan, odometry: dict[str, RobotOdometry], now_ns: int
     orientations = np.tile([0.0, 0.0, 0.0, 1.0], (k, 1))
     stale = []
     wrong_frame = None
-    ages = np.zeros(k)
+    ages, speeds = np.zeros(k), np.zeros(k)
     for i, name in enumerate(plan.names):
         entry = odometry.get(name)
         if entry is None or now_ns - entry.received_ns > timeout_sec * 1e9:
@@ -200,5 +201,6 @@ def fleet_state(plan: KnownPlan, odometry: dict[str, RobotOdometry], now_ns: int
         positions[i] = entry.position
         orientations[i] = entry.orientation
         ages[i] = (now_ns - entry.received_ns) * 1e-9
+        speeds[i] = entry.speed
     mask = np.array([name in stale for name in plan.names])
-    return FleetState(positions, orientations, tuple(stale), mask, ages, wrong_frame)
+    return FleetState(positions, orientations, tuple(stale), mask, ages, speeds, wrong_frame)

@@ -269,7 +269,8 @@ class ExecutorSettings:
     discovery_timeout: float = Spec(
         'discovery_timeout', 'double', 5.0,
         'How long a new goal waits for odometry from every robot of the plan before it '
-        'is refused with UNKNOWN_ROBOTS (s).', low=0.0, high=1e3).field()
+        'is refused with UNKNOWN_ROBOTS, and for every robot to be at rest before it is '
+        'refused with NOT_AT_START (s).', low=0.0, high=1e3).field()
     hold_timeout: float = Spec(
         'hold_timeout', 'double', 5.0,
         'How long the plan clock may hold during a goal (s): then every robot gets zero '

@@ -148,13 +148,18 @@ class Outcome:
 
 @dataclass(frozen=True, eq=False)
 class RobotOdometry:
-    """The last odometry of one robot: pose, frame, stamp and arrival time (node clock)."""
+    """
+    The last odometry of one robot: pose, frame, stamp and arrival time (node clock).
+
+    speed: its twist's linear speed (m/s, in any frame; NaN where the twist is not finite).
+    """
 
     position: np.ndarray
     orientation: np.ndarray
     frame_id: str
     stamp_ns: int
     received_ns: int
+    speed: float = 0.0
 
     def problem(self) -> str:
         """Return why the pose is no pose to track ('' when it is one)."""
