@@ -228,6 +228,21 @@ def test_a_robot_made_holonomic_while_driving_brakes_where_it_goes():
     assert abs(moved[0]) < 1e-9 and 0.1 < moved[1] < 0.15  # v^2 / 2a = 0.125 m along +y
 
 
+def test_a_robot_made_differential_while_driving_keeps_its_speed():
+    """Made differential at 0.5 m/s along +x (its heading), its forward speed ramps from 0.5."""
+    fleet = Fleet(np.zeros((1, 3)), FleetSettings(max_acceleration=np.array([0.5])))
+    now = 0.0
+    for _ in range(40):
+        fleet.command(0, [0.5, 0.0, 0.0], now)
+        fleet.step(now, 0.05)
+        now += 0.05
+    fleet.configure(FleetSettings(max_acceleration=np.array([0.5]),
+                                  differential=np.array([True])))
+    fleet.command(0, [0.5, 0.0, 0.0], now)
+    fleet.step(now, 0.05)
+    assert fleet.forward[0] == pytest.approx(0.5)  # it fell to 0.025, 9.5 m/s^2
+
+
 def test_a_differential_robot_on_a_reference_of_one_pose_finishes():
     """A reference of one pose: the robot is there and finishes (the turns ahead raised)."""
     reference = Reference(np.zeros(1), np.array([[[1.0, 1.0, 0.0]]]),

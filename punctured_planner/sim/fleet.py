@@ -144,6 +144,13 @@ class Fleet:
         self._linear[made_holonomic] = np.divide(
             self.velocities[made_holonomic], factors, where=factors > 0,
             out=np.zeros_like(self.velocities[made_holonomic]))  # factor 0: it stands
+        # and a robot made differential, facing +x as a holonomic one does, ramps its
+        # forward speed from its velocity along +x (it dropped 0.475 m/s in one step)
+        made_differential = ~was_differential & self.differential
+        factors = self.speed_factors[made_differential]
+        self._ramped[made_differential, 0] = np.divide(
+            self.velocities[made_differential, 0], factors, where=factors > 0,
+            out=np.zeros(int(made_differential.sum())))
         self.headings[holonomic] = self.yaw_rates[holonomic] = self.forward[holonomic] = 0.0
         self._ramped[holonomic] = 0.0
         self.accelerations = np.broadcast_to(
