@@ -80,6 +80,23 @@ def test_venv_node_stops_cleanly(ros_client, ros_env, tmp_path):
     assert_clean(cycles)
 
 
+@pytest.mark.parametrize('number', [signal.SIGINT, signal.SIGTERM])
+def test_a_second_signal_during_the_stop_is_no_kill(ros_env, tmp_path, number):
+    """Two signals 50 ms apart: exit 0 (the second hit the restored default, -2 or -15)."""
+    script = venv_script('planner_node')
+    node = NodeProcess([script] + node_arguments('/pp_twice_%d' % number), ros_env,
+                       str(tmp_path / 'twice.log'), '/pp_twice_%d' % number)
+    try:
+        assert wait_for_text(node.log_path, b'serving', node.proc, 30), node.log()
+        node.proc.send_signal(number)
+        time.sleep(0.05)
+        node.proc.send_signal(number)
+        assert node.proc.wait(timeout=20) == 0, node.log()
+        assert 'Traceback' not in node.log(), node.log()
+    finally:
+        node.stop()
+
+
 def test_a_caller_that_missed_its_reply_gets_it_after_the_stop(ros_client, ros_env, tmp_path):
     # A k = 512 reply (565 KB) is larger than the node's shared-memory segment: a
     # caller frozen while it goes out misses part of it, and Fast DDS resends that at
@@ -112,6 +129,31 @@ def test_the_stop_does_not_wait_once_no_caller_is_left(ros_client):
     started = time.monotonic()
     planner.close()
     assert time.monotonic() - started < REPLY_GRACE_SEC / 2
+
+
+def test_a_client_polling_the_parameters_does_not_hold_the_stop(ros_client):
+    # The parameter services every node has reply small and at once: a dashboard that
+    # polls them held every stop for LINGER_LIMIT_SEC (8.2 s against 0.2 s without it).
+    from punctured_planner.ros.runtime import REPLY_GRACE_SEC
+    from rclpy.parameter_client import AsyncParameterClient
+    planner = InProcessPlanner()
+    parameters = AsyncParameterClient(ros_client.node, planner.node.get_fully_qualified_name())
+    closing = threading.Thread(target=planner.close)
+    try:
+        assert parameters.wait_for_services(timeout_sec=10)
+        polled = parameters.get_parameters(['max_speed'])
+        assert ros_client.spin_until(polled.done, 10)
+        started = time.monotonic()
+        closing.start()
+        while closing.is_alive() and time.monotonic() - started < 2 * REPLY_GRACE_SEC:
+            parameters.get_parameters(['max_speed'])
+            ros_client.spin_until(lambda: False, 0.1)
+        stopped = time.monotonic() - started
+    finally:
+        if closing.ident is None:
+            planner.close()
+        closing.join(timeout=20)
+    assert stopped < REPLY_GRACE_SEC / 2, stopped
 
 
 def test_a_request_that_comes_while_the_participant_stays_is_answered(ros_client):

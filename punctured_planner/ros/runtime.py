@@ -155,7 +155,9 @@ class StopSignals:
     SIGINT and SIGTERM as one wake-up the main thread waits for (a context manager).
 
     Inside ``with StopSignals() as signals:`` both signals only wake
-    :meth:`wait`; on leaving, the previous handlers and wake-up fd come back.
+    :meth:`wait`; on leaving, the previous handlers and wake-up fd come back, unless
+    a stop signal came: then both stay ignored, as the process is on its way out (a
+    second Ctrl-C or SIGTERM in its last 0.2 s of teardown killed it, exit -2 or -15).
     Enter it from the main thread (Python sets signal handlers only there).
     """
 
@@ -164,6 +166,7 @@ class StopSignals:
         self._previous: dict = {}
         self._previous_fd = -1
         self._read_fd = self._write_fd = -1
+        self._stopped = False
 
     def __enter__(self) -> 'StopSignals':
         """Install the handlers and the wake-up pipe."""
@@ -175,9 +178,9 @@ class StopSignals:
         return self
 
     def __exit__(self, *exc_info) -> None:
-        """Restore the previous handlers and wake-up fd; close the pipe."""
+        """Restore the previous handlers (ignore both after a stop) and wake-up fd."""
         for number, handler in self._previous.items():
-            signal.signal(number, handler)
+            signal.signal(number, signal.SIG_IGN if self._stopped else handler)
         signal.set_wakeup_fd(self._previous_fd)
         os.close(self._read_fd)
         os.close(self._write_fd)
@@ -187,6 +190,7 @@ class StopSignals:
         while True:
             for number in os.read(self._read_fd, 64):
                 if number in STOP_SIGNALS or number == _WOKEN:
+                    self._stopped = self._stopped or number in STOP_SIGNALS
                     return number
 
     def wake(self) -> None:
@@ -200,6 +204,15 @@ class StopSignals:
 def _with_traceback(words: str, error: BaseException) -> str:
     """Return a log line: words, then the error's traceback."""
     return words + ':\n' + ''.join(traceback.format_exception(error))
+
+
+# The interface packages of the services rclpy gives every node.
+_EVERY_NODES_INTERFACES = ('rcl_interfaces', 'type_description_interfaces')
+
+
+def _everyones(service: Service) -> bool:
+    """Return whether service is one rclpy gives every node (parameters, type description)."""
+    return service.srv_type.__module__.split('.')[0] in _EVERY_NODES_INTERFACES
 
 
 def _never() -> bool:
@@ -328,8 +341,17 @@ class ExecutorThreads:
         return not condition()
 
     def _replied_by(self, service: Optional[Service], node: Node) -> float:
-        """Note that ``service`` of ``node`` (None: an action server) replied; return when."""
-        now = self._last_reply = time.monotonic()
+        """
+        Note that ``service`` of ``node`` (None: an action server) replied; return when.
+
+        Not the services every node has (parameters, type descriptions): their replies
+        are small and quick, and a client polling them (rqt, a dashboard) held every
+        stop for LINGER_LIMIT_SEC.
+        """
+        now = time.monotonic()
+        if service is not None and _everyones(service):
+            return now
+        self._last_reply = now
         if service is not None:
             self._replied[service.srv_name] = node
         else:
