@@ -159,20 +159,41 @@ def test_a_nodes_parameter_files_are_checked_together(tmp_path):
     for rename in ('__node:=fleet_planner', 'planner_node:__node:=fleet_planner'):
         PLANNER.check_files(['--ros-args', '-r', rename, '--params-file', str(others)])
     # rcl's nested form is read as the name it spells: its values (as the node takes
-    # them under a namespace), its typos, and other nodes' sections alone refused
+    # them in that namespace), its typos, and other nodes' sections alone refused
     nested = tmp_path / 'nested.yaml'
+    in_fleet = ['--ros-args', '-r', '__ns:=/fleet', '--params-file', str(nested)]
     nested.write_text('fleet:\n  planner_node:\n    ros__parameters: {max_speed: 2.0}\n')
-    PLANNER.check_files(['--ros-args', '--params-file', str(nested)])
+    PLANNER.check_files(in_fleet)
     assert load_parameter_file(str(nested), PLANNER) == {'max_speed': 2.0}
     nested.write_text('fleet:\n  planner_node:\n    ros__parameters: {max_sped: 2.0}\n')
     with pytest.raises(InvalidParameterFile, match="unknown parameter 'max_sped'"):
-        PLANNER.check_files(['--ros-args', '--params-file', str(nested)])
+        PLANNER.check_files(in_fleet)
     nested.write_text('fleet:\n  plan_executor:\n    ros__parameters: {gain: 1.0}\n'
                       '  "**":\n    ros__parameters: {max_speed: 3.0, gain: 1.0}\n')
     assert load_parameter_file(str(nested), PLANNER) == {'max_speed': 3.0}
     nested.write_text('fleet:\n  plan_executor:\n    ros__parameters: {gain: 1.0}\n')
     with pytest.raises(InvalidParameterFile, match='no section applies to planner_node'):
-        PLANNER.check_files(['--ros-args', '--params-file', str(nested)])
+        PLANNER.check_files(in_fleet)
+    # sections are matched against the node's full name as rcl matches them: a node in
+    # / or /robots started on its defaults from a section for another namespace, and
+    # /* (every node in /) was refused
+    for section, namespace, applies in (('/other/planner_node', '/', False),
+                                        ('planner_node', '/robots', False),
+                                        ('fleet: {planner_node: ', '/', False),
+                                        ('/robots/**', '/', False),
+                                        ('/robots/**', '/robots', True),
+                                        ('/*', '/', True), ('/*', '/robots', False),
+                                        ('/**/planner_node', '/a/b', True)):
+        if section.endswith(': '):
+            nested.write_text(section + '{ros__parameters: {max_speed: 2.0}}}\n')
+        else:
+            nested.write_text('%s:\n  ros__parameters: {max_speed: 2.0}\n' % section)
+        arguments = ['--ros-args', '-r', '__ns:=' + namespace, '--params-file', str(nested)]
+        if applies:
+            PLANNER.check_files(arguments)
+        else:
+            with pytest.raises(InvalidParameterFile, match='in namespace %s' % namespace):
+                PLANNER.check_files(arguments)
 
 
 @pytest.mark.parametrize('table, values, words', [

@@ -307,17 +307,24 @@ class Table(Generic[S]):
         them (load_parameter_file); one file of several may be other nodes' alone.
         The values are the node's to check when it declares them. A command line that
         renames the node (__node:=) is not checked: its sections carry the new name.
+        Sections are matched against the node's full name as rcl matches them, its
+        namespace from the command line's __ns:= (a section for /other/planner_node
+        started a node in / on its defaults).
         """
         arguments = list(arguments)
         # -r __node:=NAME, or -r planner_node:__node:=NAME for this node alone
         if any('__node:=' in argument or '__name:=' in argument for argument in arguments):
             return
+        # -r __ns:=/NS, or -r planner_node:__ns:=/NS; the last one counts
+        namespaces = [argument.split('__ns:=', 1)[1] for argument in arguments
+                      if '__ns:=' in argument]
+        namespace = namespaces[-1] if namespaces else '/'
         paths = [arguments[i + 1] for i, argument in enumerate(arguments[:-1])
                  if argument == '--params-file']
         applies = not paths
         for path in paths:
             try:
-                read = read_parameter_file(path, self)
+                read = read_parameter_file(path, self, namespace)
             except OSError as error:
                 raise InvalidParameterFile([path], '--params-file %s: %s'
                                            % (path, error.strerror)) from None
@@ -331,7 +338,7 @@ class Table(Generic[S]):
                                            parameter=unknown)
         if not applies:
             raise InvalidParameterFile(paths, '--params-file %s: %s'
-                                       % (', '.join(paths), _no_section(self)))
+                                       % (', '.join(paths), _no_section(self, namespace)))
 
     def settings(self, values: dict) -> S:
         """
@@ -467,9 +474,35 @@ def load_parameter_file(path: str, table: Table) -> dict:
     return read.values
 
 
-def _no_section(table: Table) -> str:
-    """Return the reason a file is not the node's: no section names it."""
-    return 'no section applies to %s (/** or %s)' % (table.node_name, table.node_name)
+def _no_section(table: Table, namespace: str | None = None) -> str:
+    """Return the reason a file is not the node's: no section names it (in namespace)."""
+    where = '' if namespace is None else ' in namespace %s' % namespace
+    return 'no section applies to %s%s (/** or %s)' % (table.node_name, where,
+                                                       table.node_name)
+
+
+def _section_pattern(key: str) -> re.Pattern:
+    """
+    Return the full node names a section key applies to, as rcl reads the key.
+
+    A leading '/' is implied; '*' is one name of the path, '**' any number of them.
+    """
+    tokens = ['(/[^/]+)*' if token == '**' else '/[^/]+' if token == '*'
+              else '/' + re.escape(token) for token in key.strip('/').split('/')]
+    return re.compile(''.join(tokens))
+
+
+def _applies(key: str, node_name: str, namespace: str | None) -> bool:
+    """
+    Return whether the section key applies to node_name in namespace.
+
+    namespace None: in any namespace (``punctured-planner plan``, which has none): the
+    key's last name is the node's or a wildcard.
+    """
+    if namespace is None:
+        return key.rstrip('/').split('/')[-1] in (node_name, '*', '**')
+    full_name = '/'.join(['', *namespace.strip('/').split('/'), node_name]).replace('//', '/')
+    return _section_pattern(key).fullmatch(full_name) is not None
 
 
 def _sections(data: dict, prefix: str = '') -> Iterator[tuple[str, Any]]:
@@ -487,19 +520,21 @@ def _sections(data: dict, prefix: str = '') -> Iterator[tuple[str, Any]]:
             yield name, section
 
 
-def read_parameter_file(path: str, table: Table) -> FileValues:
+def read_parameter_file(path: str, table: Table,
+                        namespace: str | None = None) -> FileValues:
     """
     Return one node's parameter values from a ROS 2 parameter YAML file.
 
-    Sections that apply to the node are merged in file order: ``/**``, the node's
-    name with or without a leading slash or namespace. As a node takes what it
-    declares, a ``/**`` section gives only the table's parameters (the others are
-    other nodes'), and rclpy's own (use_sim_time) are left out; a name the node's
-    own section sets and the table lacks is kept (settings() refuses it: a typo).
-    rcl's nested form (a namespace mapping to node sections, ``robots: {planner_node:
-    {ros__parameters: ...}}``) is read as the name it spells (robots/planner_node),
-    a namespace's ``**`` as ``/**``. Raises InvalidParameterFile for a file that is not
-    a ROS parameter file.
+    Sections that apply to the node in namespace (None: any, _applies) are merged in
+    file order, each key read as rcl reads it (_section_pattern: ``/**``,
+    ``/**/planner_node``, ``/*``, ``/ns/planner_node``, ``planner_node`` for
+    ``/planner_node``). As a node takes what it declares, a section whose node name is
+    a wildcard gives only the table's parameters (the others are other nodes'), and rclpy's own
+    (use_sim_time) are left out; a name the node's own section sets and the table
+    lacks is kept (settings() refuses it: a typo). rcl's nested form (a namespace
+    mapping to node sections, ``robots: {planner_node: {ros__parameters: ...}}``) is
+    read as the name it spells (robots/planner_node). Raises InvalidParameterFile for a
+    file that is not a ROS parameter file.
     """
     with open(path, encoding='utf-8') as stream:
         data = yaml.safe_load(stream) or {}
@@ -509,10 +544,10 @@ def read_parameter_file(path: str, table: Table) -> FileValues:
     values: dict = {}
     applied = False
     for key, section in _sections(data):
-        last = key.rstrip('/').split('/')[-1]
-        shared = last == '**'
-        if not shared and last != table.node_name:
+        if not _applies(key, table.node_name, namespace):
             continue
+        # a section for every node (its name a wildcard) holds other nodes' parameters too
+        shared = key.rstrip('/').split('/')[-1] in ('*', '**')
         applied = True
         if not isinstance(section, dict) or 'ros__parameters' not in section:
             raise InvalidParameterFile([path], '%s: section %r has no ros__parameters'
