@@ -411,6 +411,21 @@ def test_empty_list_parameters_have_their_list_type(planner, ros_client):
         ParameterType.PARAMETER_STRING_ARRAY]
 
 
+def test_robot_names_whose_topics_rcl_refuses_are_refused_on_set(planner):
+    """
+    A valid relative name too long for a topic in the namespace: refused, the old ones kept.
+
+    It was taken, every old subscription destroyed and the new ones failed (the log only
+    said so).
+    """
+    node = planner(robot_names=['a', 'b'])
+    result, = node.set_parameters(robot_names=['x' * 300])
+    assert not result.successful
+    assert "robot_names[0]: the topics of robot 'xxx" in result.reason, result.reason
+    assert 'topic length should not exceed' in result.reason, result.reason
+    assert node.node.get_parameter('robot_names').value == ['a', 'b']
+
+
 def test_settings_the_obstacles_parameter_cannot_take_are_refused(planner, ros_client):
     """
     Radii, walls or obstacles the parameter's set cannot be planned with: refused on set.

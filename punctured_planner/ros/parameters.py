@@ -34,6 +34,11 @@ from rcl_interfaces.msg import ParameterType
 from rcl_interfaces.msg import SetParametersResult
 import yaml
 
+from .topics import CMD_VEL
+from .topics import ODOM
+from .topics import PLAN
+from .topics import REFERENCE_POSE
+from .topics import robot_topic
 from ..core.limits import length_range
 from ..core.limits import lengths_in_range
 
@@ -392,6 +397,7 @@ class NodeParameters(Generic[S]):
             node.declare_parameter(spec.name, spec.default, spec.descriptor())
         self._type_empty_lists()
         self.settings: S = table.settings(self.values())
+        self._check_robot_topics(self.settings)
         if check is not None:
             check(self.settings, set(table.by_name))
         node.add_on_set_parameters_callback(self._on_set)
@@ -430,11 +436,34 @@ class NodeParameters(Generic[S]):
                 'allowed)' % ', '.join(deleted)))
         try:
             settings = self._table.settings(self.values(parameters))
+            self._check_robot_topics(settings)
             if self._check is not None:
                 self._check(settings, {p.name for p in parameters})
         except ValueError as error:
             return SetParametersResult(successful=False, reason=str(error))
         return SetParametersResult(successful=True)
+
+    def _check_robot_topics(self, settings: S) -> None:
+        """
+        Raise InvalidParameter for a robot name whose topics rcl refuses in the namespace.
+
+        A relative name (ros_names) can still make a topic longer than rcl allows (247
+        characters) once the node's namespace is put before it: a robot_names change was
+        taken, its subscriptions went, and the new ones failed (at start, a traceback).
+        """
+        for spec in self._table.specs:
+            if spec.check is not ros_names:
+                continue
+            for index, robot in enumerate(getattr(settings, spec.name)):
+                try:
+                    self._node.resolve_topic_name(robot_topic(robot, _LONGEST_ROBOT_TOPIC))
+                except Exception as error:  # noqa: B902 - rclpy's RCLError, not exported
+                    raise InvalidParameter(spec.name, '%s[%d]: the topics of robot %r are '
+                                           'no valid topic names in namespace %s: %s'
+                                           % (spec.name, index, robot,
+                                              self._node.get_namespace(),
+                                              str(error).split(', at ')[0]),
+                                           index=index) from None
 
     def _after_set(self, parameters: list) -> None:
         """Take the accepted values into the settings and the node."""
@@ -449,6 +478,8 @@ class NodeParameters(Generic[S]):
             '%s=%r' % (p.name, p.value) for p in parameters))
 
 
+# The longest of a robot's topic names (ros.topics): if it resolves, every one does.
+_LONGEST_ROBOT_TOPIC = max((PLAN, ODOM, CMD_VEL, REFERENCE_POSE), key=len)
 # Parameters rclpy declares on every node: a file may set them; they are not ours.
 RCLPY_PARAMETERS = ('use_sim_time', 'start_type_description_service')
 
