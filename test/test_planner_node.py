@@ -411,6 +411,23 @@ def test_empty_list_parameters_have_their_list_type(planner, ros_client):
         ParameterType.PARAMETER_STRING_ARRAY]
 
 
+def test_parameters_set_with_another_type_keep_their_own(planner):
+    """
+    robot_radius set to the integer 1, obstacles to a bool array []: still double, double array.
+
+    They were taken (dynamic typing), and then get_parameter_types and describe said
+    integer and bool array, where msg_docs says double and double array.
+    """
+    from rclpy.parameter import Parameter
+    node = planner(robot_radius=0.1)
+    results = node.node.set_parameters([Parameter('robot_radius', value=1),
+                                        Parameter('obstacles', Parameter.Type.BOOL_ARRAY, [])])
+    assert all(result.successful for result in results), results
+    radius, obstacles = (node.node.get_parameter(name) for name in ('robot_radius', 'obstacles'))
+    assert (radius.type_, radius.value) == (Parameter.Type.DOUBLE, 1.0)
+    assert (obstacles.type_, obstacles.value) == (Parameter.Type.DOUBLE_ARRAY, [])
+
+
 def test_robot_names_whose_topics_rcl_refuses_are_refused_on_set(planner):
     """
     A valid relative name too long for a topic in the namespace: refused, the old ones kept.

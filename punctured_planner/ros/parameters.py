@@ -393,32 +393,46 @@ class NodeParameters(Generic[S]):
         self._table = table
         self._apply = apply
         self._check = check
+        self._retyping = False
         for spec in table.specs:
             node.declare_parameter(spec.name, spec.default, spec.descriptor())
-        self._type_empty_lists()
         self.settings: S = table.settings(self.values())
+        self._retype(table.by_name)
         self._check_robot_topics(self.settings)
         if check is not None:
             check(self.settings, set(table.by_name))
         node.add_on_set_parameters_callback(self._on_set)
         node.add_post_set_parameters_callback(self._after_set)
 
-    def _type_empty_lists(self) -> None:
+    def _retype(self, names: Iterable[str]) -> None:
         """
-        Give every empty list parameter its list type (not read-only ones: rclpy keeps those).
+        Give the named parameters their spec's type where they arrived with another.
 
-        rclpy types an empty list default as a byte array, and ``[]`` in a parameter
-        file leaves the parameter not set: ``ros2 param get`` said so, ``ros2 param
-        dump`` wrote null, and loading that dump was refused.
+        Doubles and lists take other types on purpose (dynamic typing: ``ros2 param set
+        ... robot_radius 1`` is an integer, ``[]`` a byte or bool array, and a start
+        value may be either), checked by Spec.value; but then ``ros2 param get`` and
+        describe_parameters said integer or bool array where msg_docs says double. An
+        empty list default rclpy types as a byte array, and ``[]`` in a parameter file
+        leaves the parameter unset: ``ros2 param dump`` wrote null, and loading that dump
+        was refused. Not read-only ones: rclpy keeps those.
         """
         from rclpy.parameter import Parameter  # the node's: rclpy is loaded
         # rclpy's Parameter.Type values are rcl_interfaces' ParameterType's (_KINDS)
-        empty = [Parameter(spec.name, Parameter.Type(_KINDS[spec.kind]), [])
-                 for spec in self._table.specs
-                 if spec.kind.endswith('_array') and not spec.read_only
-                 and not self._node.get_parameter(spec.name).value]
-        if empty:
-            self._node.set_parameters(empty)
+        retyped = []
+        for name in names:
+            spec = self._table.by_name[name]
+            wanted = Parameter.Type(_KINDS[spec.kind])
+            if spec.read_only or self._node.get_parameter(name).type_ == wanted:
+                continue
+            value = getattr(self.settings, name)
+            retyped.append(Parameter(name, wanted,
+                                     list(value) if spec.kind.endswith('_array') else value))
+        if retyped:
+            self._retyping = True  # the same values: the post-set below applies them
+            try:
+                self._node.set_parameters(retyped)
+            finally:
+                self._retyping = False
 
     def values(self, change: Iterable[Any] = ()) -> dict:
         """Return the node's parameter values, with a proposed change (rclpy Parameters)."""
@@ -469,8 +483,12 @@ class NodeParameters(Generic[S]):
         """Take the accepted values into the settings and the node."""
         try:
             self.settings = self._table.settings(self.values())
+            if self._retyping:
+                return
+            changed = {p.name for p in parameters}
+            self._retype(changed & set(self._table.by_name))
             if self._apply is not None:
-                self._apply(self.settings, {p.name for p in parameters})
+                self._apply(self.settings, changed)
         except Exception as error:  # a parameter change never stops the node
             self._node.get_logger().error('applying parameters failed: %r' % error)
             return
