@@ -77,7 +77,7 @@ help:
 	@echo 'make run    start the planner node in the foreground (after setup)'
 	@echo 'make test   run the whole test suite: unit, lint, DDS, colcon (after setup)'
 	@echo 'make setup  create .venv, install pinned packages, build the interfaces'
-	@echo 'make bench  benchmarks beside OMPL (a few minutes): bench/results.md, results.png'
+	@echo 'make bench  benchmarks beside OMPL (about 15 minutes): bench/results.md, results.png'
 	@echo '           and plan execution over DDS: bench/execution.md'
 	@echo 'make demo   simulated fleet + planner + executor: demo.mcap, demo.gif'
 	@echo '            (DRIVE=differential: four TurtleBot-like differential robots)'
@@ -122,7 +122,7 @@ $(STAMP_PROJECT): | $(STAMP_IFACE)
 test: setup
 	$(VPY) -m pytest test/ $(PYTEST_ARGS)
 
-# Not part of make test: a few minutes, and OMPL only installed here.
+# Not part of make test: about 15 minutes, and OMPL only installed here.
 bench: setup
 	@$(PIP_INSTALL) -r bench/requirements.txt -c constraints.txt 2>&1 | $(PIP_FILTER)
 	$(VPY) bench/run_all.py $(BENCH_ARGS)

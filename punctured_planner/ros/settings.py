@@ -274,8 +274,8 @@ class ExecutorSettings:
     hold_timeout: float = Spec(
         'hold_timeout', 'double', 5.0,
         'How long the plan clock may hold during a goal (s): then every robot gets zero '
-        'velocity and the goal aborts, with ODOMETRY_LOST for stale odometry, else with '
-        'CLOCK_HELD (a robot that does not follow).',
+        'velocity (mode velocity) and the goal aborts, with ODOMETRY_LOST for stale '
+        'odometry, else with CLOCK_HELD (a robot that does not follow).',
         low=0.0, high=1e3).field()
     shared_clock: str = Spec(
         'shared_clock', 'string', 'on',
