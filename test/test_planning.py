@@ -374,6 +374,39 @@ def test_a_change_the_topics_obstacles_cannot_take_is_refused_on_set():
                                       topic, {'obstacle_radius'})
 
 
+def test_no_obstacles_plan_whatever_the_per_obstacle_radii():
+    """
+    An empty obstacle set beside per-obstacle radii plans: the radii wait for a set.
+
+    The parameter set was taken, and then every request was refused (INVALID_REQUEST,
+    'obstacle_radius must be a scalar or one value per obstacle'); the same empty set
+    on the topic was refused.
+    """
+    from punctured_planner_interfaces.srv import PlanSequence
+    handler = PlanSequenceHandler()
+    settings = PLANNER.settings({'obstacle_radius': [0.1, 0.2], 'robot_radius': 0.1})
+    empty = ObstacleSet(np.zeros((0, 3)), 'map', '/obstacles', 5)
+    handler.check_parameter_obstacles(settings, empty, {'obstacles'})
+    handler.check_obstacles(settings, empty)
+    outcome = handler.handle(make_request(), PlanSequence.Response(),
+                             Snapshot(settings, empty), 0)
+    assert outcome.ok, outcome.response.error_msg
+
+
+def test_a_request_faster_than_the_parameters_range_is_refused():
+    """max_speed 1e9: INVALID_REQUEST (its stamps, 1 ns apart, spanned 68 ns for 5 ns)."""
+    from punctured_planner_interfaces.srv import PlanSequence
+    flat = [v for o in OBSTACLES for v in o]
+    for speed in (1e9, 1e300):
+        outcome = PlanSequenceHandler().handle(make_request(max_speed=speed),
+                                               PlanSequence.Response(),
+                                               snapshot(obstacles=flat), 0)
+        assert outcome.response.error_code == PlanSequence.Response.INVALID_REQUEST
+        assert 'at most 1e+06 m/s' in outcome.response.error_msg
+    assert PlanSequenceHandler().handle(make_request(max_speed=1e6), PlanSequence.Response(),
+                                        snapshot(obstacles=flat), 0).ok
+
+
 def test_free_text_in_a_message_is_never_read_as_a_slot():
     """A frame id with braces is quoted as it is (the message is a template)."""
     outcome = answer(make_request(frame_id='{configuration}'), snapshot(), 0)

@@ -60,6 +60,7 @@ PARAMETERS = {
 MAX_SAMPLES_PER_LEG = 1000  # msg_docs/parameters.md: samples_per_leg range
 PLANE_TOLERANCE = 1e-9  # msg_docs: z must equal plane_z within 1e-9
 MAX_COORDINATE = 1e15  # the core refuses coordinates beyond this (INVALID_REQUEST)
+MAX_SPEED = 1e6  # msg_docs: a request's max_speed above it is INVALID_REQUEST
 CODE = ErrorCode
 
 
@@ -176,7 +177,7 @@ def documented_outcome(spec, state):
     if (n > PARAMETERS['max_configurations'] or max(counts) > PARAMETERS['max_robots']
             or samples > MAX_SAMPLES_PER_LEG):
         return {CODE.REQUEST_OVER_LIMITS: None}, None
-    if not math.isfinite(spec['max_speed']):
+    if not (math.isfinite(spec['max_speed']) and spec['max_speed'] <= MAX_SPEED):
         return {CODE.INVALID_REQUEST: None}, None
     for m, count in enumerate(counts):
         if count == 0:
@@ -321,7 +322,7 @@ GRID = st.integers(-8, 8).map(lambda v: v / 2)
 BAD_XY = (math.nan, math.inf, -math.inf, 1e300, -1e16, 2e15)
 Z_VALUES = (0.0, -0.0, 1e-10, 1e-9, 2e-9, 1.0, -1e300, math.nan)
 FRAMES = ('map', '', 'odom', 'Map', '/map', 'map ')
-SPEEDS = (0.0, -1.0, 0.25, 3.0, 1e6, math.nan, math.inf, -math.inf)
+SPEEDS = (0.0, -1.0, 0.25, 3.0, 1e6, 1e9, math.nan, math.inf, -math.inf)
 SAMPLES = (-1, 0, 1, 3, 100, MAX_SAMPLES_PER_LEG + 1, 2 ** 31 - 1, -(2 ** 31))
 MUTATIONS = ('bad_xy', 'z', 'frame', 'drop', 'extra', 'empty', 'coincide', 'on_obstacle',
              'many_configurations', 'many_robots', 'samples', 'speed')

@@ -22,6 +22,7 @@ import numpy as np
 
 from . import conversions
 from .settings import MAX_SAMPLES_PER_LEG
+from .settings import MAX_SPEED
 from .settings import PlannerSettings
 from .snapshot import format_stamp
 from .snapshot import in_other_frame
@@ -119,8 +120,9 @@ def gather(request: Any, snapshot: Snapshot, now_ns: int) -> Gathered:
                else settings.samples_per_leg)
     _check_limits(settings, n, counts, samples)
     max_speed = request.max_speed
-    if not math.isfinite(max_speed):
-        fail(ErrorCode.INVALID_REQUEST, 'max_speed must be finite, got %r' % max_speed)
+    if not (math.isfinite(max_speed) and max_speed <= MAX_SPEED):
+        fail(ErrorCode.INVALID_REQUEST, 'max_speed must be finite and at most %g m/s (the '
+             "max_speed parameter's range), got %r" % (MAX_SPEED, max_speed))
     for m, count in enumerate(counts):
         if count == 0:
             raise PlanningError(ErrorCode.INVALID_REQUEST, '{configuration} has no robots',

@@ -43,6 +43,9 @@ from ..sim import FleetSettings
 AUTO = 'auto'
 # Largest samples_per_leg a parameter or a request may ask for.
 MAX_SAMPLES_PER_LEG = 1000
+# The fastest max_speed (m/s), the parameter's and a request's: at 1e9 the stamps, 1 ns
+# apart at least, spanned 68 ns of a motion whose duration said 5 ns.
+MAX_SPEED = 1e6
 
 
 @dataclass(frozen=True)
@@ -119,7 +122,7 @@ class PlannerSettings:
     max_speed: float = Spec(
         'max_speed', 'double', 1.0,
         "Speed of the fastest robot on each leg (m/s) when a request's max_speed is "
-        '<= 0.', low=1e-6, high=1e6).field()
+        '<= 0.', low=1e-6, high=MAX_SPEED).field()
     max_acceleration: float = Spec(
         'max_acceleration', 'double', 0.0,
         "Acceleration limit of every robot (m/s^2) the stamps respect: each leg's speed "
