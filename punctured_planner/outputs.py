@@ -12,6 +12,7 @@ from contextlib import contextmanager
 from contextlib import suppress
 import errno
 import os
+import stat
 
 
 @contextmanager
@@ -19,17 +20,24 @@ def replacing(path: str | os.PathLike[str]) -> Iterator[str]:
     """
     Yield the path to write instead of path; on success it replaces path, else it goes.
 
-    The file is written in path's folder (a move within one file system is atomic,
+    The file is written in the folder of the file path names (a link is followed: the
+    link stays, its target is replaced; a move within one file system is atomic,
     os.replace) under a hidden name of this process, created by the writer itself, so
-    it gets the permissions any new file would.
+    it gets the permissions any new file would. A path that is no regular file (a
+    device such as /dev/null, a pipe) is written as it is: replacing it would put a
+    file in its place.
     """
-    folder, name = os.path.split(os.path.abspath(os.fspath(path)))
+    target = os.path.realpath(os.fspath(path))
+    if os.path.exists(target) and not stat.S_ISREG(os.stat(target).st_mode):
+        yield target
+        return
+    folder, name = os.path.split(target)
     if not os.path.isdir(folder):  # named for the path asked for, not the hidden one
         raise FileNotFoundError(errno.ENOENT, 'no folder %s' % folder, os.fspath(path))
     part = os.path.join(folder, '.%s.%d.part' % (name, os.getpid()))
     try:
         yield part
-        os.replace(part, path)
+        os.replace(part, target)
     except BaseException:
         with suppress(OSError):
             os.unlink(part)

@@ -82,16 +82,18 @@ def test_venv_node_stops_cleanly(ros_client, ros_env, tmp_path):
 
 @pytest.mark.parametrize('number', [signal.SIGINT, signal.SIGTERM])
 def test_a_second_signal_during_the_stop_is_no_kill(ros_env, tmp_path, number):
-    """Two signals 50 ms apart: exit 0 (the second hit the restored default, -2 or -15)."""
+    """Signals every 10 ms from the first on: exit 0 (one hit the restored default, -2 or -15)."""
     script = venv_script('planner_node')
     node = NodeProcess([script] + node_arguments('/pp_twice_%d' % number), ros_env,
                        str(tmp_path / 'twice.log'), '/pp_twice_%d' % number)
     try:
         assert wait_for_text(node.log_path, b'serving', node.proc, 30), node.log()
-        node.proc.send_signal(number)
-        time.sleep(0.05)
-        node.proc.send_signal(number)
-        assert node.proc.wait(timeout=20) == 0, node.log()
+        # whenever the stop leaves run_nodes (later on a loaded machine), a signal follows
+        deadline = time.monotonic() + 20.0
+        while node.proc.poll() is None and time.monotonic() < deadline:
+            node.proc.send_signal(number)
+            time.sleep(0.01)
+        assert node.proc.wait(timeout=5) == 0, node.log()
         assert 'Traceback' not in node.log(), node.log()
     finally:
         node.stop()

@@ -36,6 +36,17 @@ def test_quaternions_are_normalised_or_identity():
     assert np.allclose(q, [[1, 0, 0, 0], [0, 1, 0, 0], [0.5 ** 0.5, 0.5 ** 0.5, 0, 0]])
 
 
+def test_odometry_reports_its_speed_and_a_twist_not_finite_as_none():
+    """The twist's speed for the at-rest start; NaN would have held every goal."""
+    from nav_msgs.msg import Odometry
+    msg = Odometry()
+    msg.pose.pose.orientation.w = 1.0
+    msg.twist.twist.linear.x, msg.twist.twist.linear.y = 0.3, 0.4
+    assert conversions.robot_odometry(msg, 0).speed == pytest.approx(0.5)
+    msg.twist.twist.linear.x = math.nan
+    assert conversions.robot_odometry(msg, 0).speed == 0.0
+
+
 def test_message_arrays_round_trip():
     msg = pose_array(CONFIGURATIONS[1], orientations=[YAW_90] * 4)
     assert np.array_equal(conversions.pose_array_positions(msg), CONFIGURATIONS[1])

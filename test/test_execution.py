@@ -288,7 +288,8 @@ def test_a_stale_robot_keeps_its_last_heading():
     from punctured_planner.ros.snapshot import RobotOdometry
     plan = conversions.known_plan(faulty_plan('none'))
     facing_y = np.array([0.0, 0.0, np.sqrt(0.5), np.sqrt(0.5)])
-    odometry = {name: RobotOdometry(plan.reference.position(0.0)[i], facing_y, 'map', 0, 0)
+    odometry = {name: RobotOdometry(plan.reference.position(0.0)[i], facing_y, 'map', 0, 0,
+                                    0.0)
                 for i, name in enumerate(plan.names)}
     state = fleet_state(plan, odometry, int(2e9), 0.5)
     assert state.stale == tuple(plan.names)
@@ -307,7 +308,7 @@ def test_odometry_in_another_frame_names_the_robot_and_both_frames():
     for frame, expected in (('', None), ('odom', WrongFrame(plan.names[1], 'odom', 'map'))):
         frames[plan.names[1]] = frame
         odometry = {name: RobotOdometry(plan.reference.position(0.0)[i], IDENTITY, frames[name],
-                                        0, 0) for i, name in enumerate(plan.names)}
+                                        0, 0, 0.0) for i, name in enumerate(plan.names)}
         assert fleet_state(plan, odometry, 0, 0.5).wrong_frame == expected
 
 

@@ -138,6 +138,12 @@ def test_parameter_files(tmp_path):
     path.write_text('- not a mapping\n')
     with pytest.raises(ValueError):
         load_parameter_file(str(path), PLANNER)
+    # a misspelt ros__parameters beside a /** section: refused, as rcl refuses the file (read
+    # as a namespace, it was ignored and the shared values alone taken)
+    path.write_text('/**:\n  ros__parameters: {max_speed: 1.0}\n'
+                    'planner_node:\n  ros_parameters: {max_speed: 2.0}\n')
+    with pytest.raises(ValueError, match="'planner_node/ros_parameters' has no ros__param"):
+        load_parameter_file(str(path), PLANNER)
 
 
 def test_a_nodes_parameter_files_are_checked_together(tmp_path):

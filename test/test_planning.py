@@ -163,6 +163,22 @@ def test_stamps_past_2038_name_the_limit_that_binds():
         assert outcome.response.error_msg.endswith(culprit), outcome.response.error_msg
 
 
+def test_a_request_no_answer_of_which_fits_is_refused_before_planning(monkeypatch):
+    """Under max_poses even with one moving leg a segment: refused, nothing planned."""
+    from punctured_planner_interfaces.srv import PlanSequence
+
+    def planned(*args):
+        raise AssertionError('planned a request no answer of which fits')
+
+    monkeypatch.setattr(PlanSequenceHandler, '_plan', planned)
+    request = make_request(samples_per_leg=100)  # 4 robots, 1 + 101 per segment at least
+    outcome = PlanSequenceHandler().handle(
+        request, PlanSequence.Response(),
+        snapshot(obstacles=[v for o in OBSTACLES for v in o], max_poses=400), 0)
+    assert outcome.response.error_code == PlanSequence.Response.REQUEST_OVER_LIMITS
+    assert 'more than max_poses 400' in outcome.response.error_msg
+
+
 def test_array_holding_dataclasses_compare_by_identity():
     """Frame, ObstacleSet, RobotState, PlaneView: == and hash work (no numpy ValueError)."""
     from punctured_planner.core import Workspace

@@ -189,8 +189,13 @@ def documented_outcome(spec, state):
     fault = ros_fault(configurations, frames, counts)
     if fault is not None:
         return {fault[0]: fault[1]}, None
+    # max_poses before planning: one moving leg a segment between configurations that differ
+    stacked = np.stack(configurations)
+    differ = int(np.any(np.diff(stacked, axis=0) != 0, axis=(1, 2)).sum())
+    if counts[0] * (differ * (samples + 1) + 1) > PARAMETERS['max_poses']:
+        return {CODE.REQUEST_OVER_LIMITS: None}, None
     try:
-        planned = plan(workspace(), np.stack(configurations)[..., :2])
+        planned = plan(workspace(), stacked[..., :2])
     except PlanningError as error:
         return {error.code: error.configuration}, None
     # max_poses, once planned: the answer's own poses, a leg in which no robot moves

@@ -284,3 +284,18 @@ def test_an_output_is_written_whole_or_the_old_one_stays(tmp_path):
     render_png(example_plan(), path, dpi=20)
     assert path.read_bytes()[:8] == b'\x89PNG\r\n\x1a\n'
     assert sorted(p.name for p in tmp_path.iterdir()) == ['plan.png']
+    # a link stays a link, its target replaced; a pipe (as /dev/null a device) is written
+    # as it is, not replaced by a file
+    import os
+    import stat
+    link = tmp_path / 'link.png'
+    link.symlink_to(path)
+    with replacing(link) as part:
+        with open(part, 'wb') as stream:
+            stream.write(b'new')
+    assert link.is_symlink() and path.read_bytes() == b'new'
+    pipe = tmp_path / 'pipe'
+    os.mkfifo(pipe)
+    with replacing(pipe) as part:
+        assert part == str(pipe)
+    assert stat.S_ISFIFO(os.stat(pipe).st_mode)

@@ -31,7 +31,7 @@ AT_REST_SPEED = 0.05
 
 
 def still_moving(speeds: np.ndarray) -> np.ndarray:
-    """Return the indices of the robots not at rest: speed above AT_REST_SPEED, or NaN."""
+    """Return the indices of the robots not at rest: speed above AT_REST_SPEED (or NaN)."""
     return np.flatnonzero(~(np.asarray(speeds) <= AT_REST_SPEED))
 
 

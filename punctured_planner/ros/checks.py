@@ -147,8 +147,8 @@ def _check_limits(settings: PlannerSettings, n: int, counts: list[int], samples:
 
     Not max_poses: an answer's pose count is known only once planned (check_poses),
     as legs in which no robot moves add none, and with use_current_state leading
-    configurations that repeat the state are dropped. Counted from the variants'
-    fixed legs before planning, answers that fit were refused.
+    configurations that repeat the state are dropped (_check_fewest_poses bounds it
+    once converted).
     """
     if n > settings.max_configurations:
         fail(ErrorCode.REQUEST_OVER_LIMITS, '%d configurations, more than '
@@ -228,7 +228,22 @@ def check(gathered: Gathered, snapshot: Snapshot) -> Checked:
     dropped = [m - 1 for m in range(1, len(positions)) if m not in planned]
     if dropped:
         positions, orientations = positions[planned], orientations[planned]
+    _check_fewest_poses(settings, positions, gathered.samples_per_leg)
     return Checked(positions, orientations, planned, dropped)
+
+
+def _check_fewest_poses(settings: PlannerSettings, positions: np.ndarray,
+                        samples: int) -> None:
+    """
+    REQUEST_OVER_LIMITS before planning when no answer through positions fits max_poses.
+
+    A segment between two configurations that differ has a leg in which some robot
+    moves, so the answer has at least one breakpoint more for it (a leg in which none
+    moves adds none): a bound no answer stays under, unlike the variants' fixed legs,
+    which refused answers that fit. The exact count is checked once planned.
+    """
+    moved = int(np.any(np.diff(positions, axis=0) != 0, axis=(1, 2)).sum())
+    check_poses(settings, positions.shape[1], moved + 1, samples)
 
 
 def _check_range(settings: PlannerSettings, points: np.ndarray, counts: list[int]) -> None:

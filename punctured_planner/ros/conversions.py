@@ -126,9 +126,11 @@ def robot_odometry(msg: Odometry, received_ns: int) -> RobotOdometry:
     """Return the RobotOdometry of a nav_msgs/Odometry message that arrived at received_ns."""
     pose = odometry_pose(msg)
     linear = msg.twist.twist.linear
+    speed = math.hypot(linear.x, linear.y, linear.z)
+    # a twist that is not finite says nothing: as none reported (its pose still counts)
     return RobotOdometry(pose.position, pose.orientation, msg.header.frame_id,
                          stamp_to_ns(msg.header.stamp), int(received_ns),
-                         math.hypot(linear.x, linear.y, linear.z))
+                         speed if math.isfinite(speed) else 0.0)
 
 
 def obstacles_from_parameter(values: npt.ArrayLike) -> np.ndarray:
@@ -163,7 +165,7 @@ def to_xyz(points: npt.ArrayLike, plane_z: float = 0.0) -> np.ndarray:
 
 # Norms between these come from squares that neither overflow nor lose precision below
 # the smallest normal float.
-_SQUARES_SAFE = (1e-150, 1e150)
+_SMALLEST_SAFE_NORM, _LARGEST_SAFE_NORM = 1e-150, 1e150
 
 
 def normalized_quaternions(quaternions: npt.ArrayLike) -> np.ndarray:
@@ -175,7 +177,7 @@ def normalized_quaternions(quaternions: npt.ArrayLike) -> np.ndarray:
         norms = np.sqrt(np.add.reduce(quaternions * quaternions, axis=-1, keepdims=True))
         # A finite one whose squares overflow (1e200) or underflow (1e-170) is scaled by
         # its largest component first, not taken for a non-finite or zero one.
-        extreme = ~((norms > _SQUARES_SAFE[0]) & (norms < _SQUARES_SAFE[1]))
+        extreme = ~((norms > _SMALLEST_SAFE_NORM) & (norms < _LARGEST_SAFE_NORM))
         largest = np.abs(quaternions).max(axis=-1, keepdims=True)
         scale = np.where(extreme & (largest > 0) & np.isfinite(largest), largest, 1.0)
         quaternions = quaternions / scale

@@ -462,8 +462,8 @@ class NodeParameters(Generic[S]):
         Raise InvalidParameter for a robot name whose topics rcl refuses in the namespace.
 
         A relative name (ros_names) can still make a topic longer than rcl allows (247
-        characters) once the node's namespace is put before it: a robot_names change was
-        taken, its subscriptions went, and the new ones failed (at start, a traceback).
+        characters) once the node's namespace is put before it: refused here, in on-set
+        and at declaration, before any subscription is replaced.
         """
         for spec in self._table.specs:
             if spec.check is not ros_names:
@@ -558,12 +558,15 @@ def _sections(data: dict, prefix: str = '') -> Iterator[tuple[str, Any]]:
     """
     Yield (name, section) of a parameter file's mapping, nested namespaces joined by '/'.
 
-    A mapping without ros__parameters is a namespace (rcl's nested form); anything else
-    is a node's section (or a malformed one, for its reader to refuse).
+    A mapping of mappings without ros__parameters is a namespace (rcl's nested form);
+    anything else is a node's section, or a malformed one (a value before any
+    ros__parameters, as a misspelt ros_parameters makes: its reader refuses it, as rcl
+    refuses the file).
     """
     for key, section in data.items():
         name = prefix + str(key)
-        if isinstance(section, dict) and section and 'ros__parameters' not in section:
+        if (isinstance(section, dict) and section and 'ros__parameters' not in section
+                and all(isinstance(inner, dict) for inner in section.values())):
             yield from _sections(section, name.rstrip('/') + '/')
         else:
             yield name, section
@@ -593,14 +596,15 @@ def read_parameter_file(path: str, table: Table,
     values: dict = {}
     applied = False
     for key, section in _sections(data):
+        # whichever node it is for: rcl refuses the whole file
+        if not isinstance(section, dict) or 'ros__parameters' not in section:
+            raise InvalidParameterFile([path], '%s: section %r has no ros__parameters'
+                                       % (path, key))
         if not _applies(key, table.node_name, namespace):
             continue
         # a section for every node (its name a wildcard) holds other nodes' parameters too
         shared = key.rstrip('/').split('/')[-1] in ('*', '**')
         applied = True
-        if not isinstance(section, dict) or 'ros__parameters' not in section:
-            raise InvalidParameterFile([path], '%s: section %r has no ros__parameters'
-                                       % (path, key))
         parameters = section['ros__parameters'] or {}
         if not isinstance(parameters, dict):
             raise InvalidParameterFile([path], '%s: section %r: ros__parameters must map names '

@@ -89,8 +89,8 @@ class PlanSequenceHandler:
                               variant=settings.core_variant, min_spacing=settings.min_spacing,
                               required_clearance=settings.required_clearance,
                               robot_radius=settings.robot_radius,
-                              # no obstacles, no radius to fit: per-obstacle radii may wait
-                              # for a set (an empty one refused every request with code 4)
+                              # no obstacles, no radius to fit: per-obstacle radii wait
+                              # for a set
                               obstacle_radius=(settings.core_obstacle_radius if len(obstacles)
                                                else 0.0),
                               bounds=settings.core_bounds)

@@ -43,8 +43,8 @@ from ..sim import FleetSettings
 AUTO = 'auto'
 # Largest samples_per_leg a parameter or a request may ask for.
 MAX_SAMPLES_PER_LEG = 1000
-# The fastest max_speed (m/s), the parameter's and a request's: at 1e9 the stamps, 1 ns
-# apart at least, spanned 68 ns of a motion whose duration said 5 ns.
+# The fastest max_speed (m/s), the parameter's and a request's: far beyond it the stamps,
+# 1 ns apart at least, outlast the motion's duration.
 MAX_SPEED = 1e6
 
 

@@ -151,7 +151,7 @@ class RobotOdometry:
     """
     The last odometry of one robot: pose, frame, stamp and arrival time (node clock).
 
-    speed: its twist's linear speed (m/s, in any frame; NaN where the twist is not finite).
+    speed: its twist's linear speed (m/s, in any frame; 0 where the twist is not finite).
     """
 
     position: np.ndarray
@@ -159,7 +159,7 @@ class RobotOdometry:
     frame_id: str
     stamp_ns: int
     received_ns: int
-    speed: float = 0.0
+    speed: float
 
     def problem(self) -> str:
         """Return why the pose is no pose to track ('' when it is one)."""

@@ -136,16 +136,15 @@ class Fleet:
         # says: it kept its last heading, which the executor rotated its commands by, so a
         # command along +x drove it along -y.
         holonomic = ~self.differential
-        # and its ramp starts from the velocity it has (before its factor): the ramp had
-        # followed its body-frame commands, (forward, 0, 0), so told to stop while driving
-        # along +y it slid 0.12 m along +x
+        # and ramps from the velocity it has (before its factor), not from the ramp of its
+        # body-frame commands (forward, 0, 0), which would slide it sideways
         made_holonomic = was_differential & holonomic
         factors = self.speed_factors[made_holonomic, None]
         self._linear[made_holonomic] = np.divide(
             self.velocities[made_holonomic], factors, where=factors > 0,
             out=np.zeros_like(self.velocities[made_holonomic]))  # factor 0: it stands
-        # and a robot made differential, facing +x as a holonomic one does, ramps its
-        # forward speed from its velocity along +x (it dropped 0.475 m/s in one step)
+        # a robot made differential, facing +x as a holonomic one does, ramps its forward
+        # speed from its velocity along +x, within its acceleration limit
         made_differential = ~was_differential & self.differential
         factors = self.speed_factors[made_differential]
         self._ramped[made_differential, 0] = np.divide(
