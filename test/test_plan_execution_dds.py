@@ -566,7 +566,10 @@ def test_a_goal_starts_only_with_its_robots_at_rest(ros_client, lone_executor):
         # still moving after discovery_timeout: NOT_AT_START, the robots and speeds named
         parameters = AsyncParameterClient(node, executor.name('plan_executor'))
         assert parameters.wait_for_services(timeout_sec=10)
-        future = parameters.set_parameters([Parameter('discovery_timeout', value=0.5)])
+        # a stale robot is refused first (UNKNOWN_ROBOTS): odometry that a stalled test
+        # process publishes late must not count as stale within the half second
+        future = parameters.set_parameters([Parameter('discovery_timeout', value=0.5),
+                                            Parameter('odom_timeout', value=5.0)])
         assert ros_client.spin_until(future.done, 10)
         assert all(r.successful for r in future.result().results), future.result()
         speed[0] = 0.3
@@ -583,6 +586,7 @@ def test_a_goal_starts_only_with_its_robots_at_rest(ros_client, lone_executor):
         # with the reason when it starts, as at its arrival (an internal error, 99, before)
         future = parameters.set_parameters([Parameter('discovery_timeout', value=5.0)])
         assert ros_client.spin_until(future.done, 10)
+        assert all(r.successful for r in future.result().results), future.result()
         sent = action.send_goal_async(ExecutePlan.Goal(plan_id=message.plan_id))
         assert ros_client.spin_until(sent.done, 10) and sent.result().accepted
         future = parameters.set_parameters([Parameter('drive',
