@@ -215,11 +215,13 @@ def report(soak, elapsed, cpu):
     for index, seconds, rss, hwm in soak.memory:
         print('%8d %8.1f %10.1f %10.1f' % (index, seconds, rss, hwm))
     rss = np.array([m[2] for m in soak.memory])
-    half = len(rss) // 2
-    slope = np.polyfit([m[0] for m in soak.memory[half:]], rss[half:], 1)[0] * 1000
+    # the second half's samples, at least two (a line through one is no slope)
+    half = min(len(rss) // 2, len(rss) - 2)
+    growth = ('%.3f MiB per 1000 calls' % (np.polyfit(
+        [m[0] for m in soak.memory[half:]], rss[half:], 1)[0] * 1000)
+              if half >= 0 else 'n/a (one sample: --every above --calls)')
     print('memory: start %.1f MiB, final %.1f MiB, peak (VmHWM) %.1f MiB, growth over the '
-          'second half %.3f MiB per 1000 calls'
-          % (rss[0], rss[-1], soak.memory[-1][3], slope))
+          'second half %s' % (rss[0], rss[-1], soak.memory[-1][3], growth))
     print('failures: %d' % len(soak.failures))
     for failure in soak.failures[:20]:
         print('  call %d (%s): %s' % failure)
@@ -235,8 +237,10 @@ def main(argv=None):
     parser.add_argument('--seed', type=int, default=7)
     parser.add_argument('--log-level', default='info', help="the node's (default info)")
     args = parser.parse_args(argv)
+    # The robot state is published once, at warm-up: no age limit, or every
+    # use_current_state call after max_state_age (0.5 s) would be refused.
     parameters = {'obstacles': '[%s]' % ','.join(str(v) for point in OBSTACLES for v in point),
-                  'max_configurations': MAX_CONFIGURATIONS}
+                  'max_configurations': MAX_CONFIGURATIONS, 'max_state_age': '0.0'}
     with planner_session('soak', parameters, args.log_level, domain_offset=70) as session:
         process = session.process
         soak = Soak(session.node, session.executor, session.namespace, process.pid, args)
