@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import itertools
 import math
 from typing import Any
+from typing import Callable
 
 import numpy as np
 
@@ -175,7 +176,7 @@ def check_poses(settings: PlannerSettings, robot_count: int, breakpoints: int,
                                                     settings.max_poses))
 
 
-def check_duration(duration: float, at_speed_alone: float, max_speed: float,
+def check_duration(duration: float, at_speed_alone: Callable[[], float], max_speed: float,
                    max_acceleration: float, start_ns: int) -> None:
     """
     INVALID_REQUEST when the motion's stamps do not fit builtin_interfaces/Time.
@@ -183,15 +184,15 @@ def check_duration(duration: float, at_speed_alone: float, max_speed: float,
     Time and Duration carry int32 seconds: the last stamp must come before
     2038-01-19 and the duration must stay below 2^31 s. Known only once the
     plan's length is, so checked after planning. The message names the limit to
-    raise: max_acceleration where the motion at max_speed alone (at_speed_alone)
-    would fit.
+    raise: max_acceleration where the motion at max_speed alone (at_speed_alone(),
+    computed for a refusal only) would fit.
     """
     def fits(seconds: float) -> bool:
         return math.isfinite(seconds) and start_ns + seconds * 1e9 < _LAST_STAMP_NS
 
     if fits(duration):
         return
-    if max_acceleration > 0 and fits(at_speed_alone):
+    if max_acceleration > 0 and fits(at_speed_alone()):
         limits, culprit = ('max_speed %.6g m/s and max_acceleration %.6g m/s^2'
                            % (max_speed, max_acceleration), 'max_acceleration')
     else:

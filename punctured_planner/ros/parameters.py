@@ -398,7 +398,7 @@ class NodeParameters(Generic[S]):
             node.declare_parameter(spec.name, spec.default, spec.descriptor())
         self.settings: S = table.settings(self.values())
         self._retype(table.by_name)
-        self._check_robot_topics(self.settings)
+        self._check_robot_topics(self.settings, table.by_name)
         if check is not None:
             check(self.settings, set(table.by_name))
         node.add_on_set_parameters_callback(self._on_set)
@@ -450,23 +450,26 @@ class NodeParameters(Generic[S]):
                 'allowed)' % ', '.join(deleted)))
         try:
             settings = self._table.settings(self.values(parameters))
-            self._check_robot_topics(settings)
+            self._check_robot_topics(settings, {p.name for p in parameters})
             if self._check is not None:
                 self._check(settings, {p.name for p in parameters})
         except ValueError as error:
             return SetParametersResult(successful=False, reason=str(error))
         return SetParametersResult(successful=True)
 
-    def _check_robot_topics(self, settings: S) -> None:
+    def _check_robot_topics(self, settings: S, names: Iterable[str]) -> None:
         """
         Raise InvalidParameter for a robot name whose topics rcl refuses in the namespace.
+
+        Of the parameters names (those set; all at declaration) that hold robot names.
 
         A relative name (ros_names) can still make a topic longer than rcl allows (247
         characters) once the node's namespace is put before it: refused here, in on-set
         and at declaration, before any subscription is replaced.
         """
-        for spec in self._table.specs:
-            if spec.check is not ros_names:
+        for name in names:
+            spec = self._table.by_name.get(name)
+            if spec is None or spec.check is not ros_names:
                 continue
             for index, robot in enumerate(getattr(settings, spec.name)):
                 try:

@@ -218,14 +218,13 @@ class PlanSequenceHandler:
         max_speed, max_acceleration = gathered.max_speed, settings.max_acceleration
         with np.errstate(over='ignore', divide='ignore', invalid='ignore'):
             duration = the_plan.duration(max_speed, max_acceleration)
-            # what the motion lasts at max_speed alone: which limit a refusal names
-            at_speed_alone = the_plan.duration(max_speed)
             # The answer's own breakpoints: the refinement's knots add to any schedule's,
             # and a leg in which no robot moves adds none.
             breakpoints = the_plan.stamped_breakpoints(max_speed, max_acceleration)
         checks.check_poses(settings, gathered.counts[0], breakpoints, gathered.samples_per_leg)
-        checks.check_duration(duration, at_speed_alone, max_speed, max_acceleration,
-                              start_ns)
+        # what the motion lasts at max_speed alone (which limit a refusal names): only then
+        checks.check_duration(duration, lambda: the_plan.duration(max_speed), max_speed,
+                              max_acceleration, start_ns)
         samples = the_plan.sample(gathered.samples_per_leg, max_speed, max_acceleration)
         paths = conversions.plan_to_paths(samples, checked.orientations, settings.frame_id,
                                           start_ns, settings.plane_z)

@@ -136,20 +136,18 @@ class Fleet:
         # says: it kept its last heading, which the executor rotated its commands by, so a
         # command along +x drove it along -y.
         holonomic = ~self.differential
-        # and ramps from the velocity it has (before its factor), not from the ramp of its
-        # body-frame commands (forward, 0, 0), which would slide it sideways
+        # A robot whose drive changed ramps from the velocity it has, before its factor (0
+        # for a factor 0: it stands): made holonomic, not from the ramp of its body-frame
+        # commands (forward, 0, 0), which would slide it sideways; made differential
+        # (facing +x, as a holonomic one does), its forward speed from its velocity along
+        # +x, within its acceleration limit.
+        factors = self.speed_factors[:, None]
+        commanded = np.divide(self.velocities, factors, where=factors > 0,
+                              out=np.zeros_like(self.velocities))
         made_holonomic = was_differential & holonomic
-        factors = self.speed_factors[made_holonomic, None]
-        self._linear[made_holonomic] = np.divide(
-            self.velocities[made_holonomic], factors, where=factors > 0,
-            out=np.zeros_like(self.velocities[made_holonomic]))  # factor 0: it stands
-        # a robot made differential, facing +x as a holonomic one does, ramps its forward
-        # speed from its velocity along +x, within its acceleration limit
+        self._linear[made_holonomic] = commanded[made_holonomic]
         made_differential = ~was_differential & self.differential
-        factors = self.speed_factors[made_differential]
-        self._ramped[made_differential, 0] = np.divide(
-            self.velocities[made_differential, 0], factors, where=factors > 0,
-            out=np.zeros(int(made_differential.sum())))
+        self._ramped[made_differential, 0] = commanded[made_differential, 0]
         self.headings[holonomic] = self.yaw_rates[holonomic] = self.forward[holonomic] = 0.0
         self._ramped[holonomic] = 0.0
         self.accelerations = np.broadcast_to(
