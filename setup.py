@@ -25,9 +25,9 @@ setup(
     license='Apache-2.0',
     entry_points={
         'console_scripts': [
-            'planner_node = punctured_planner.nodes.planner:main',
-            'plan_executor = punctured_planner.nodes.executor:main',
-            'fleet_sim = punctured_planner.nodes.fleet_sim:main',
+            'planner_node = punctured_planner.nodes.start:planner_node',
+            'plan_executor = punctured_planner.nodes.start:plan_executor',
+            'fleet_sim = punctured_planner.nodes.start:fleet_sim',
             'punctured-planner = punctured_planner.cli:main',
         ],
     },

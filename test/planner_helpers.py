@@ -78,6 +78,7 @@ class InProcessPlanner:
         group = planner_nodes(context=self.context, namespace=self.namespace,
                               parameter_overrides=overrides)
         self.node = group.nodes[0]
+        self.before_teardown = group.before_teardown
         self.threads = ExecutorThreads(group.nodes, context=self.context,
                                        on_stop=group.on_stop)
         self.threads.start()
@@ -95,7 +96,8 @@ class InProcessPlanner:
     def close(self):
         """Stop the executor threads, destroy the nodes, shut the Context down."""
         import rclpy
-        assert self.threads.close(), 'callbacks still running: %s' % self.threads.stuck()
+        closed = self.threads.close(before_teardown=self.before_teardown)
+        assert closed, 'callbacks still running: %s' % self.threads.stuck()
         rclpy.try_shutdown(context=self.context)
 
 

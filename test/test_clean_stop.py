@@ -99,6 +99,42 @@ def test_a_second_signal_during_the_stop_is_no_kill(ros_env, tmp_path, number):
         node.stop()
 
 
+@pytest.mark.parametrize('script', ['planner_node', 'plan_executor', 'fleet_sim'])
+def test_a_signal_while_the_node_still_imports_stops_it_cleanly(ros_env, script):
+    """
+    SIGINT or SIGTERM while the process imports rclpy: it starts its nodes, stops, exit 0.
+
+    Signalled as soon as rclpy's library is loaded, 0.1 - 0.4 s into the start, well
+    before run_nodes: Python's default handlers ended it with a KeyboardInterrupt
+    traceback (-2) or -15 (doc/design.md section 16).
+    """
+    for number in (signal.SIGINT, signal.SIGTERM):
+        namespace = '/pp_early_%s_%d' % (script, number)
+        process = subprocess.Popen([venv_script(script), '--ros-args', '-r',
+                                    '__ns:=' + namespace], env=ros_env,
+                                   stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+        try:
+            while '_rclpy_pybind11' not in _mapped(process.pid):
+                assert process.poll() is None, process.communicate()[0].decode()
+                time.sleep(0.002)
+            process.send_signal(number)
+            output = process.communicate(timeout=60)[0].decode()
+        finally:
+            process.kill()
+            process.wait()
+        assert process.returncode == 0, (number, output)
+        assert 'Traceback' not in output, output
+
+
+def _mapped(pid):
+    """Return what the process has mapped (/proc/<pid>/maps), '' once it has gone."""
+    try:
+        with open('/proc/%d/maps' % pid) as maps:
+            return maps.read()
+    except FileNotFoundError:
+        return ''
+
+
 def test_a_caller_that_missed_its_reply_gets_it_after_the_stop(ros_client, ros_env, tmp_path):
     # A k = 512 reply (565 KB) is larger than the node's shared-memory segment: a
     # caller frozen while it goes out misses part of it, and Fast DDS resends that at

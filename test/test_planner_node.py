@@ -568,6 +568,84 @@ def test_parameters_answer_while_a_plan_runs(planner, ros_client, monkeypatch):
     assert planned.result().error_code == 0, planned.result().error_msg
 
 
+def test_the_service_answers_while_a_plan_is_published(planner, ros_client, monkeypatch):
+    """
+    The next request is answered while the plan before it is still being published.
+
+    The outputs' thread publishes, in the order the plans were answered. On the
+    service's thread, a 1.99 M-pose plan was published for 20 s after its reply, and a
+    4-robot request sent behind it waited 39 s (doc/design.md section 11).
+    """
+    import threading
+
+    from punctured_planner.ros import publications
+    from punctured_planner_interfaces.msg import Plan
+    publishing, release = threading.Event(), threading.Event()
+    real_messages = publications.plan_messages
+
+    def held_messages(*args, **kwargs):
+        publishing.set()
+        release.wait(20)  # a large plan being published
+        return real_messages(*args, **kwargs)
+
+    monkeypatch.setattr(publications, 'plan_messages', held_messages)
+    node = planner(obstacles=flat(OBSTACLES))
+    client = service_client(ros_client, node)
+    published = Latest(ros_client.node, Plan, node.name('plan'))
+    try:
+        first = ros_client.call(client, make_request())
+        assert first.error_code == 0, first.error_msg
+        assert ros_client.spin_until(publishing.is_set, 20)
+        second = client.call_async(make_request())
+        assert ros_client.spin_until(second.done, 10), 'the reply waited for the publishing'
+        assert second.result().error_code == 0, second.result().error_msg
+        assert published.messages == []
+    finally:
+        release.set()
+    # Both published, in the order answered (a reader of depth 1 may see the last only).
+    last = second.result().plan_id
+    assert ros_client.spin_until(
+        lambda: published.last is not None and published.last.plan_id == last, 20)
+    ids = [m.plan_id for m in published.messages]
+    assert ids in ([first.plan_id, last], [last]), ids
+
+
+def test_a_plan_answered_as_the_stop_begins_is_published(ros_client, monkeypatch):
+    """
+    A plan answered after the outputs' thread stopped is published at teardown.
+
+    The request is in flight when the stop begins: the outputs' thread has left its
+    loop when the reply goes out, and NodeGroup.before_teardown publishes the plan
+    before the participant goes (within STOP_PLANNING_SEC, doc/design.md section 16).
+    """
+    import threading
+
+    import punctured_planner.core as core
+    from punctured_planner_interfaces.msg import Plan
+    taken = threading.Event()
+    real_plan = core.plan
+
+    def slow_plan(*args, **kwargs):
+        taken.set()
+        time.sleep(1.5)  # in flight while the stop begins
+        return real_plan(*args, **kwargs)
+
+    monkeypatch.setattr(core, 'plan', slow_plan)
+    node = InProcessPlanner(obstacles=flat(OBSTACLES))
+    client = service_client(ros_client, node)
+    published = Latest(ros_client.node, Plan, node.name('plan'))
+    planned = client.call_async(make_request())
+    assert ros_client.spin_until(taken.is_set, 20)
+    closing = threading.Thread(target=node.close)
+    closing.start()
+    assert ros_client.spin_until(planned.done, 30)
+    assert planned.result().error_code == 0, planned.result().error_msg
+    assert ros_client.spin_until(lambda: published.last is not None, 10), 'not published'
+    assert published.last.plan_id == planned.result().plan_id
+    closing.join(30)
+    assert not closing.is_alive()
+
+
 def test_odometry_assembles_the_current_state(planner, ros_client):
     """With robot_names, each <name>/odom feeds the current state (frame checked)."""
     plan_sequence, _, _, _, _, odometry = _types()

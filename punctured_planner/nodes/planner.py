@@ -28,19 +28,23 @@ loops on subscription traffic (ros2/rclpy#1223, #1452), and measured here, with
 obstacles and robot states at 50 Hz, service round trips went from 4 ms to 80
 ms median with stalls of 2-6 s (two single-threaded executors: 3.4 ms, worst 6
 ms). The publishers live on a third companion, ``<name>_outputs``, spun by a
-fourth thread, which wakes only when one of their QoS events fires (rclpy's default
-handlers log a subscriber with incompatible QoS or type, two per publisher).
+fourth thread, which wakes only when a plan is to be published or one of their QoS
+events fires (rclpy's default handlers log a subscriber with incompatible QoS or
+type, two per publisher).
 rclpy 7.1's executor looks each waitable of its nodes up in a plain list after
 every wake-up: with one latched Path per robot, 1,026 waitables cost 7.7 ms per
 wake-up against 0.07 ms for 2 (measured), about 6 ms per request at k = 512 on
 the service's executor; on the inputs node, which wakes with every message of
 its 50 Hz streams, that would be most of a core. A plan is answered first;
-then the request's outcome is logged and the plan published, complete, in the
-order msg_docs/topics.md gives. Start and stop (Ctrl-C and SIGTERM alike,
-threads joined before anything is destroyed):
+then the request's outcome is logged and the plan handed to the outputs' thread,
+which publishes the answered plans in the order they were answered, each complete
+and in the order of topics msg_docs/topics.md gives, while the service's thread
+takes the next request (publishing a 1.99 M-pose plan had held it 20 s). Start
+and stop (Ctrl-C and SIGTERM alike, threads joined before anything is destroyed):
 :func:`punctured_planner.ros.runtime.run_nodes`.
 """
 
+from collections import deque
 from collections.abc import Iterable
 from dataclasses import dataclass
 import functools
@@ -148,6 +152,11 @@ class PlannerNode(Node):
         self._stop: Stop | None = None  # the stop under way (NodeGroup.on_stop)
         self._collecting = True  # whether the cyclic collector ran when it was taken
         self._after_reply: AfterReply | None = None  # what to publish once it is sent
+        # Answered plans the outputs' thread has still to publish, oldest first: appended
+        # by the service's thread, taken by the outputs' (a deque's append and popleft
+        # are atomic), and at teardown by before_teardown (publish_answered).
+        self._answered: deque[AfterReply] = deque()
+        self._plans_answered = self.outputs.create_guard_condition(self.publish_answered)
         s = self._settings
         self.get_logger().info(
             'serving %s: frame %s, dimension %d, variant %s, robot radius %g, %s, robots %s'
@@ -333,15 +342,9 @@ class PlannerNode(Node):
             after, self._after_reply = self._after_reply, None
             if after is not None:
                 self._log_outcome(after)
-                if after.outcome.ok and (stop := self._past_planning()) is not None:
-                    # Publishing the largest plan took 10 s more: the stop must end, and
-                    # the caller has its plan in the reply.
-                    self.get_logger().warning(
-                        'plan_sequence #%d: plan %d answered %.0f s into the stop: not '
-                        'published' % (after.number, after.outcome.plan_id,
-                                       stop.elapsed()))
-                elif after.outcome.ok:
-                    self._publish_after_reply(after)
+                if after.outcome.ok:
+                    self._answered.append(after)
+                    self._plans_answered.trigger()
 
     def _send_attempts(self, response, header, number, sequence):
         """Send one reply, up to SEND_ATTEMPTS times while rmw reports the timeout."""
@@ -363,6 +366,25 @@ class PlannerNode(Node):
                 'number %d), attempt %d of %d: %s'
                 % (number, response.error_code, sequence, attempt, SEND_ATTEMPTS,
                    failed[0].message))
+
+    def publish_answered(self) -> None:
+        """
+        Publish every answered plan not published yet, oldest first.
+
+        The outputs' thread runs it once a reply is out; the stop runs it when no
+        thread spins any more (NodeGroup.before_teardown), for plans answered as it
+        began.
+        """
+        while self._answered:
+            after = self._answered.popleft()
+            if (stop := self._past_planning()) is not None:
+                # Publishing the largest plan took 10 s more: the stop must end, and
+                # the caller has its plan in the reply.
+                self.get_logger().warning(
+                    'plan_sequence #%d: plan %d answered, %.0f s into the stop: not '
+                    'published' % (after.number, after.outcome.plan_id, stop.elapsed()))
+            else:
+                self._publish_after_reply(after)
 
     def _publish_after_reply(self, after: AfterReply) -> None:
         """
@@ -422,7 +444,8 @@ class PlannerNode(Node):
 def planner_nodes(context: Context | None = None, **kwargs: Any) -> NodeGroup:
     """Return the PlannerNode and its server, inputs and outputs nodes: each in its own thread."""
     node = PlannerNode(context=context, **kwargs)
-    return NodeGroup([node, node.server, node.inputs, node.outputs], on_stop=node.note_stop)
+    return NodeGroup([node, node.server, node.inputs, node.outputs], on_stop=node.note_stop,
+                     before_teardown=node.publish_answered)
 
 
 def main(args: list[str] | None = None) -> int:

@@ -107,11 +107,12 @@ from rclpy.service import Service
 from rclpy.signals import SignalHandlerOptions
 from rclpy.task import Future
 
+from .early_signals import STOP_SIGNALS
+from .early_signals import take_noted
 from .parameters import Table
 from .qos import load_fastdds_profile
 from .qos import SERVER_QOS
 
-STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 # Seconds a callback in flight may take to finish after the stop signal: the largest
 # request max_poses allows (2,000,000 poses) held the planner's thread 18 s on an idle
 # machine and more than 30 s at a load of 2 on 2 cores (doc/design.md section 16).
@@ -158,7 +159,9 @@ class StopSignals:
     :meth:`wait`; on leaving, the previous handlers and wake-up fd come back, unless
     a stop signal came: then both stay ignored, as the process is on its way out (a
     second Ctrl-C or SIGTERM in its last 0.2 s of teardown killed it, exit -2 or -15).
-    Enter it from the main thread (Python sets signal handlers only there).
+    A stop signal noted while the process started (:mod:`.early_signals`) wakes
+    :meth:`wait` at once. Enter it from the main thread (Python sets signal handlers
+    only there).
     """
 
     def __init__(self) -> None:
@@ -175,6 +178,8 @@ class StopSignals:
         self._previous_fd = signal.set_wakeup_fd(self._write_fd, warn_on_full_buffer=False)
         for number in STOP_SIGNALS:
             self._previous[number] = signal.signal(number, _ignore)
+        for noted in take_noted():  # a stop signal while the process started
+            os.write(self._write_fd, bytes([noted]))
         return self
 
     def __exit__(self, *exc_info) -> None:
