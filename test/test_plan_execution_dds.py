@@ -513,6 +513,32 @@ def test_a_goal_for_a_plan_that_is_no_plan_ends_at_once_saying_why(ros_client, l
         ros_client.node.destroy_publisher(publisher)
 
 
+def test_plans_published_back_to_back_are_all_kept(ros_client, lone_executor):
+    """
+    Eight plans published in a burst are all kept (the planner publishes plans so).
+
+    The planner's outputs' thread publishes the plans answered while it published
+    another back to back (doc/design.md section 11); read with depth 1, plan_executor
+    kept plans 1 and 8 of them, and a goal for any other ended NO_PLAN.
+    """
+    from planner_helpers import faulty_plan
+    from punctured_planner.ros.qos import LATCHED
+    from punctured_planner_interfaces.msg import Plan
+    executor, _ = lone_executor
+    publisher = ros_client.node.create_publisher(Plan, executor.name('plan'), LATCHED)
+    try:
+        assert ros_client.spin_until(lambda: publisher.get_subscription_count() > 0, 10)
+        message = faulty_plan('none')
+        for plan_id in range(1, 9):
+            message.plan_id = plan_id
+            publisher.publish(message)
+        kept = ['plan %d: 4 robots' % plan_id for plan_id in range(1, 9)]
+        assert ros_client.spin_until(lambda: all(k in executor.log() for k in kept), 10), \
+            executor.log()
+    finally:
+        ros_client.node.destroy_publisher(publisher)
+
+
 def test_a_goal_starts_only_with_its_robots_at_rest(ros_client, lone_executor):
     """
     Robots at the plan's start whose odometry reports 0.3 m/s: the goal waits, then starts.

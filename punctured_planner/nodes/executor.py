@@ -82,10 +82,11 @@ from ..ros.goals import FleetState
 from ..ros.goals import InvalidPlan
 from ..ros.goals import KnownPlan
 from ..ros.goals import Lookup
+from ..ros.goals import PLAN_HISTORY
 from ..ros.goals import PlanStore
 from ..ros.parameters import NodeParameters
 from ..ros.qos import COMMANDS
-from ..ros.qos import LATCHED
+from ..ros.qos import latched
 from ..ros.qos import STATE
 from ..ros.runtime import NodeGroup
 from ..ros.runtime import REQUEST_GRACE_SEC
@@ -162,7 +163,7 @@ class PlanExecutor(Node):
         self._unfinished: set[bytes] = set()
         self._all_out: Future | None = None
         self._last_result = -math.inf  # time.monotonic() when the last result went out
-        self.create_subscription(Plan, 'plan', self._on_plan, LATCHED)
+        self.create_subscription(Plan, 'plan', self._on_plan, latched(PLAN_HISTORY))
         self._server = ActionServer(self, ExecutePlan, 'execute_plan', self._execute,
                                     goal_callback=self._on_goal,
                                     handle_accepted_callback=self._on_accepted,

@@ -29,9 +29,22 @@ from rclpy.qos import HistoryPolicy
 from rclpy.qos import QoSProfile
 from rclpy.qos import ReliabilityPolicy
 
-LATCHED = QoSProfile(depth=1, history=HistoryPolicy.KEEP_LAST,
-                     reliability=ReliabilityPolicy.RELIABLE,
-                     durability=DurabilityPolicy.TRANSIENT_LOCAL)
+
+def latched(depth: int) -> QoSProfile:
+    """
+    Return the latched QoS (reliable, transient local, keep last) with ``depth``.
+
+    A reader's depth is what it keeps of a burst until its callbacks take them:
+    plan_executor reads ``plan`` with its plan store's, as the planner may publish
+    plans back to back (those answered while one was being published), and with
+    depth 1 it kept the first and the last of eight such plans.
+    """
+    return QoSProfile(depth=depth, history=HistoryPolicy.KEEP_LAST,
+                      reliability=ReliabilityPolicy.RELIABLE,
+                      durability=DurabilityPolicy.TRANSIENT_LOCAL)
+
+
+LATCHED = latched(1)
 STATE = QoSProfile(depth=1, history=HistoryPolicy.KEEP_LAST,
                    reliability=ReliabilityPolicy.BEST_EFFORT,
                    durability=DurabilityPolicy.VOLATILE)
