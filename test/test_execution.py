@@ -123,6 +123,32 @@ def test_stale_odometry_holds_the_clock_and_it_resumes():
     assert step.rate == 1.0 and step.plan_time == pytest.approx(0.2)
 
 
+def test_a_control_period_longer_than_the_hold_margin_is_named():
+    """
+    period_overrun names each robot whose reference outruns (1 - hold_fraction) delta in a period.
+
+    make run's plan (delta 0.035 m at 0.5 m/s) under the default executor (20 Hz,
+    hold_fraction 0.6) moves 0.025 m a period against a margin of 0.014 m: over DDS
+    three robots passed delta, by up to 33%, and nothing said so (msg_docs/ExecutePlan.md).
+    """
+    from punctured_planner.execution.hold import period_overrun
+    # robot 0 at 0.5 m/s, robot 1 at 0.1 m/s; two poses at one stamp are skipped
+    reference = reference_of([0.0, 2.0, 2.0, 4.0],
+                             [[[0, 0, 0], [5, 0, 0]], [[1, 0, 0], [5, 0.2, 0]],
+                              [[1, 0, 0], [5, 0.2, 0]], [[1, 1, 0], [5, 0.2, 0]]])
+    overrun = period_overrun(reference, 0.035, 0.6, 0.05)
+    assert overrun.robots.tolist() == [0]
+    assert overrun.distances == pytest.approx([0.025]) and overrun.margin == pytest.approx(0.014)
+    assert period_overrun(reference, 0.035, 0.6, 0.02).robots.size == 0  # 50 Hz: 0.01 m
+    assert period_overrun(reference, 0.035, 0.0, 0.05).robots.size == 0  # margin all of delta
+    # and afterwards, the robots whose error passed delta
+    execution = Execution(reference, 0.035, ExecutionSettings(speed_limit=2.0))
+    assert execution.beyond_tolerance().size == 0
+    execution.step(0.05, reference.position(0.0) + [[0.0, 0.0, 0.0], [0.0, 0.05, 0.0]],
+                   [False, False])
+    assert execution.beyond_tolerance().tolist() == [1]
+
+
 def certified_fleet(k=6, seed=2, acceleration=0.0):
     """
     Return (plan reference, Bodies, min gap): k robots crossing a row of pillars.

@@ -261,6 +261,10 @@ class Execution:
         # (elapsed, plan time read) at each of the last HISTORY steps, for old positions
         self.clock_history: deque = deque(maxlen=HISTORY)
 
+    def beyond_tolerance(self) -> np.ndarray:
+        """Return the robots (indices) whose largest tracking error so far passed the tolerance."""
+        return np.flatnonzero(self.max_errors > self.tolerance)
+
     def step(self, dt: float, positions: np.ndarray, stale: np.ndarray,
              orientations: np.ndarray | None = None, ages: np.ndarray | None = None) -> Step:
         """

@@ -7,7 +7,9 @@ A plan is certified from its start, at rest: a goal starts only with every robot
 for stale odometry or for a robot that does not follow; one hold, whatever holds it,
 may last ``hold_timeout`` (:class:`ClockHold`): then the goal ends, for lost odometry
 if some robot's went stale during the hold, else for the robots the clock waits for
-(:func:`waited_for`). The plan_executor node words and sends the results.
+(:func:`waited_for`). A clock that measures errors too rarely for the plan's speed
+holds too late (:func:`period_overrun`). The plan_executor node words and sends the
+results.
 """
 
 from dataclasses import dataclass
@@ -48,6 +50,41 @@ def off_start(reference: Reference, positions: np.ndarray, tolerance: float) -> 
     away = np.linalg.norm(positions - reference.position(0.0), axis=1)
     far = np.flatnonzero(away > tolerance)
     return OffStart(far, away[far])
+
+
+@dataclass(frozen=True)
+class Overrun:
+    """
+    Robots (indices) whose reference moves farther in one control period than the margin.
+
+    distances: how far each moves in a period (m); margin: (1 - hold_fraction) x the
+    tracking tolerance (m).
+    """
+
+    robots: np.ndarray
+    distances: np.ndarray
+    margin: float
+
+
+def period_overrun(reference: Reference, tolerance: float, hold_fraction: float,
+                   period: float) -> Overrun:
+    """
+    Return the robots whose reference moves farther in one period than the hold's margin.
+
+    The clock holds once a control step measures an error of hold_fraction of the
+    tolerance: a robot that stops following falls behind by up to what its reference
+    moves in one period (and its command latency) before that, which the rest of
+    the tolerance must cover (msg_docs/ExecutePlan.md). Speeds are each stamp
+    interval's mean, a profiled reference's peak higher: a lower bound.
+    """
+    durations = np.diff(reference.seconds)
+    moving = durations > 0
+    moves = np.linalg.norm(np.diff(reference.positions, axis=0), axis=2)[moving]
+    speeds = (moves / durations[moving, None]).max(axis=0, initial=0.0)
+    travel = speeds * period
+    margin = (1.0 - hold_fraction) * tolerance
+    robots = np.flatnonzero(travel > margin)
+    return Overrun(robots, travel[robots], margin)
 
 
 @dataclass(frozen=True)

@@ -74,6 +74,7 @@ from ..execution.execution import leaving_their_plane
 from ..execution.execution import WrongCount
 from ..execution.hold import ClockHold
 from ..execution.hold import off_start
+from ..execution.hold import period_overrun
 from ..execution.hold import still_moving
 from ..execution.hold import waited_for
 from ..ros import conversions
@@ -394,7 +395,20 @@ class PlanExecutor(Node):
         if execution is not None:
             result.max_tracking_errors = execution.max_errors.tolist()
             result.min_gap = float(execution.min_gap)
+            self._warn_beyond_tolerance(run.plan, execution)
         run.done.set_result(result)
+
+    def _warn_beyond_tolerance(self, plan: KnownPlan, execution: Execution) -> None:
+        """Log the robots whose tracking error passed the tolerance: the gap was not kept."""
+        beyond = execution.beyond_tolerance()
+        if beyond.size:
+            self.get_logger().warning(
+                'plan %d: tracking errors beyond the tolerance %.4g m: %s; its bodies were '
+                'kept only min_gap - 2 x the largest, %.4g m, apart' % (
+                    plan.plan_id, plan.tolerance, ', '.join(
+                        '%s %.4g m' % (plan.names[i], execution.max_errors[i])
+                        for i in beyond),
+                    plan.min_gap - 2.0 * float(execution.max_errors.max())))
 
     # ------------------------------------------------------------ the control loop
 
@@ -485,6 +499,18 @@ class PlanExecutor(Node):
                                'the robots)' % (plan.plan_id, len(plan.names),
                                                 plan.reference.duration,
                                                 execution.reference.duration))
+        overrun = period_overrun(execution.reference, plan.tolerance, settings.hold_fraction,
+                                 1.0 / settings.control_rate)
+        if overrun.robots.size:
+            self.get_logger().warning(
+                'plan %d: in one control period (%g Hz) the reference of %s moves farther '
+                'than the %.4g m that (1 - hold_fraction) of the tracking tolerance %.4g m '
+                'leaves: a robot that stops following can pass the tolerance before the '
+                'clock holds; lower max_speeds or raise control_rate' % (
+                    plan.plan_id, settings.control_rate, ', '.join(
+                        '%s (%.4g m)' % (plan.names[i], distance)
+                        for i, distance in zip(overrun.robots, overrun.distances)),
+                    overrun.margin, plan.tolerance))
         return execution
 
     def _hold_expired(self, run: Run, step: Step, state: FleetState, now: int,
