@@ -108,3 +108,25 @@ def test_one_pass_gives_both_certificates_of_bodies(robots):
     assert both.clearance == certify(times, positions, obstacles)
     assert both.gap == certify(times, positions, obstacles, radii)
     assert both.gap.distance < both.clearance.distance
+
+
+def test_a_gap_below_the_required_clearance_is_named_before_the_resolution():
+    """
+    A required_clearance the plan misses by overlapping bodies is refused for the gap.
+
+    make run's request with required_clearance 2 m: the inflated bodies break the
+    discs theorem's condition, the plan takes robot 0's centre through pillar 1's
+    (centre distance 0, gap -0.33 m), and the refusal blamed the numerical resolution
+    of coordinates a few metres large.
+    """
+    workspace = Workspace([[-2.0, 0.5], [0.0, -0.5], [2.5, 0.0]], variant='discs',
+                          robot_radius=0.18, obstacle_radius=0.15, required_clearance=2.0)
+    request = [[[-3.0, -2.0], [-1.0, -2.5], [1.0, -2.0], [3.0, -2.5]],  # its C_1 - C_3
+               [[-2.0, -1.5], [0.0, 1.5], [1.5, -1.5], [3.5, 1.0]],
+               [[3.0, 3.0], [1.0, 3.5], [-1.0, 3.0], [-3.0, 3.5]]]
+    with pytest.raises(PlanningError) as error:
+        plan(workspace, request)
+    assert error.value.code == ErrorCode.CLEARANCE_BELOW_REQUIRED
+    words = str(error.value)
+    assert 'surface to surface (gap), < required 2' in words, words
+    assert 'resolution' not in words, words
