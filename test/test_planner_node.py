@@ -486,6 +486,23 @@ def test_settings_the_obstacles_parameter_cannot_take_are_refused(planner, ros_c
     assert response.error_code == plan_sequence.Response.NONE, response.error_msg
 
 
+def plan_slowly(monkeypatch):
+    """Make every plan take 1.5 s more (in flight as a stop begins); return the Event it sets."""
+    import threading
+
+    import punctured_planner.core as core
+    taken = threading.Event()
+    real_plan = core.plan
+
+    def slow_plan(*args, **kwargs):
+        taken.set()
+        time.sleep(1.5)
+        return real_plan(*args, **kwargs)
+
+    monkeypatch.setattr(core, 'plan', slow_plan)
+    return taken
+
+
 def test_requests_waiting_past_the_stop_budget_are_answered_node_stopping(
         ros_client, monkeypatch):
     """
@@ -499,19 +516,10 @@ def test_requests_waiting_past_the_stop_budget_are_answered_node_stopping(
     """
     import threading
 
-    import punctured_planner.core as core
     import punctured_planner.ros.runtime as runtime
     plan_sequence = _types()[0]
     monkeypatch.setattr(runtime, 'STOP_PLANNING_SEC', 0.0)
-    taken = threading.Event()
-    real_plan = core.plan
-
-    def slow_plan(*args, **kwargs):
-        taken.set()
-        time.sleep(1.5)  # in flight while the stop begins
-        return real_plan(*args, **kwargs)
-
-    monkeypatch.setattr(core, 'plan', slow_plan)
+    taken = plan_slowly(monkeypatch)
     node = InProcessPlanner(obstacles=flat(OBSTACLES))
     client = service_client(ros_client, node)
     domain = Latest(ros_client.node, _types()[3], node.name('domain_index'))
@@ -620,17 +628,8 @@ def test_a_plan_answered_as_the_stop_begins_is_published(ros_client, monkeypatch
     """
     import threading
 
-    import punctured_planner.core as core
     from punctured_planner_interfaces.msg import Plan
-    taken = threading.Event()
-    real_plan = core.plan
-
-    def slow_plan(*args, **kwargs):
-        taken.set()
-        time.sleep(1.5)  # in flight while the stop begins
-        return real_plan(*args, **kwargs)
-
-    monkeypatch.setattr(core, 'plan', slow_plan)
+    taken = plan_slowly(monkeypatch)
     node = InProcessPlanner(obstacles=flat(OBSTACLES))
     client = service_client(ros_client, node)
     published = Latest(ros_client.node, Plan, node.name('plan'))
