@@ -170,7 +170,7 @@ MARGIN = 0.1
 # Every stop is a breakpoint of the whole motion: k more per rise. Beyond this many robots
 # (k is constant on a domain) the fleet rises as one (by top - h_min, a single stop), which
 # keeps a plan of 200 robots within its time budget (doc/design.md section 6).
-STACKED_ROBOTS = 128
+STACKED_ROBOTS = 64
 
 SIDESTEP, RISE, GATHER = 'sidestep', 'rise', 'gather'
 LIFT, SLIDE, DROP = 'lift', 'slide', 'drop'
