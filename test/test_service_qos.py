@@ -114,7 +114,13 @@ def test_requests_waiting_while_the_node_is_stopped_are_all_answered(
 
 def test_every_reply_that_cannot_be_sent_is_an_error_naming_its_request(
         planner_process, clients):
-    """A client whose reply reader never matches: each attempt of each reply is logged."""
+    """
+    A client whose reply reader never matches: each attempt of each reply is logged.
+
+    A reply gets SEND_ATTEMPTS attempts (100 ms each), one once the reply before it failed
+    them all (its caller had gone), until a reply goes out: callers that left after
+    sending held the service's thread 1.1 s each (doc/design.md section 15).
+    """
     from punctured_planner.nodes.planner import SEND_ATTEMPTS
     from punctured_planner.ros.qos import CLIENT_QOS
     from punctured_planner_interfaces.srv import PlanSequence
@@ -132,20 +138,64 @@ def test_every_reply_that_cannot_be_sent_is_an_error_naming_its_request(
     served_client = plan_client(served, node, CLIENT_QOS)
     assert served.call(served_client, request).error_code == PlanSequence.Response.NONE
     futures = []
-    for number in (2, 3):
+
+    def unsent(number, attempts):
+        """Send deaf requests until request #number is taken; wait for its last attempt."""
         while 'plan_sequence #%d: ' % number not in node.log():
             futures.append(deaf_client.call_async(request))
             deaf.spin_until(lambda: False, 0.5)
-    last = 'plan_sequence #3: reply (error code 0) not sent to the client'
-    assert deaf.spin_until(lambda: ('attempt %d of %d' % (SEND_ATTEMPTS, SEND_ATTEMPTS)) in
-                           node.log().split(last)[-1], 10.0), node.log()
+        last = 'plan_sequence #%d: reply (error code 0) not sent to the client' % number
+        assert deaf.spin_until(lambda: ('attempt %d of %d' % (attempts, attempts)) in
+                               node.log().split(last)[-1], 10.0), node.log()
+
+    unsent(2, SEND_ATTEMPTS)
+    unsent(3, 1)  # the caller of #2 had gone: one attempt
     assert served.call(served_client, request).error_code == PlanSequence.Response.NONE
+    unsent(5, SEND_ATTEMPTS)  # #4 went out: every attempt again
     log = node.log()
-    for number in (2, 3):
+    for number, attempts in ((2, SEND_ATTEMPTS), (3, 1), (5, SEND_ATTEMPTS)):
         lines = [line for line in log.splitlines()
                  if 'plan_sequence #%d: reply (error code 0) not sent' % number in line]
-        assert len(lines) == SEND_ATTEMPTS, log
+        assert len(lines) == attempts, log
         assert all(line.startswith('[ERROR]') for line in lines), lines
     assert not any(f.done() for f in futures)
     assert 'Traceback' not in log
     node.assert_running()
+
+
+def test_callers_that_have_gone_cannot_hold_the_stop(planner_process, clients):
+    """
+    Requests of a caller that never gets its replies, sent all through a stop: it ends.
+
+    Their replies fail (100 ms an attempt); one of them gets SEND_ATTEMPTS attempts,
+    the rest one each, and the linger takes none after LINGER_LIMIT_SEC. Callers that
+    left after sending held a stop 60 s (exit 1, a call sent before it lost) and a
+    linger 90 s (doc/design.md section 16).
+    """
+    from punctured_planner.nodes.planner import SEND_ATTEMPTS
+    from punctured_planner.ros.qos import CLIENT_QOS
+    from punctured_planner_interfaces.srv import PlanSequence
+    from rclpy.qos import DurabilityPolicy
+    from rclpy.qos import QoSProfile
+    node = planner_process(params_file=SCENARIO)
+    request = example_request()
+    deaf = clients('deaf')
+    deaf_client = deaf.node.create_client(
+        PlanSequence, node.name('plan_sequence'),
+        qos_profile=QoSProfile(depth=10, durability=DurabilityPolicy.TRANSIENT_LOCAL))
+    served = clients('served')  # stays a client: the stop lingers for it
+    served_client = plan_client(served, node, CLIENT_QOS)
+    assert served.call(served_client, request).error_code == PlanSequence.Response.NONE
+    node.proc.send_signal(signal.SIGINT)
+    deadline = time.monotonic() + 40.0
+    while node.proc.poll() is None and time.monotonic() < deadline:
+        deaf_client.call_async(request)
+        deaf.spin_until(lambda: False, 0.02)
+    assert node.proc.poll() == 0, node.log()
+    log = node.log()
+    failed = [line for line in log.splitlines() if 'not sent to the client' in line]
+    assert failed, log  # the stop took some of the requests
+    retried = {line.split(':')[1] for line in failed if 'attempt 2 of' in line}
+    assert len(retried) <= 1, retried
+    assert sum('attempt 1 of %d' % SEND_ATTEMPTS in line for line in failed) <= 1
+    assert 'Traceback' not in log

@@ -149,6 +149,8 @@ class PlannerNode(Node):
         self._send = self._service.send_response
         self._service.send_response = self._send_response  # type: ignore[method-assign]
         self._answering = 0  # the number of the request whose reply is being sent
+        # Whether the last reply failed every attempt: its caller had gone (_send_attempts).
+        self._caller_gone = False
         self._stop: Stop | None = None  # the stop under way (NodeGroup.on_stop)
         self._collecting = True  # whether the cyclic collector ran when it was taken
         self._after_reply: AfterReply | None = None  # what to publish once it is sent
@@ -347,8 +349,21 @@ class PlannerNode(Node):
                     self._plans_answered.trigger()
 
     def _send_attempts(self, response, header, number, sequence):
-        """Send one reply, up to SEND_ATTEMPTS times while rmw reports the timeout."""
-        for attempt in range(1, SEND_ATTEMPTS + 1):
+        """
+        Send one reply, up to SEND_ATTEMPTS times while rmw reports the timeout.
+
+        Each failed attempt holds the service's thread 100 ms (rmw_fastrtps's wait for
+        the client's reader). The retries are for a new client whose reader is not
+        matched yet; a caller that has gone never will be, and callers that left
+        after sending held the thread 1.1 s each: 90 of them delayed a live call
+        29 s, and made a stop overrun 60 s, exit 1 and lose a call sent before it
+        (a review's runs over DDS, 2026-12-05). So a reply gets one attempt once
+        the reply before it failed every attempt (its caller had gone: a reply that
+        goes out ends that), and once the stop only replies (runtime.Stop).
+        """
+        attempts = (1 if self._caller_gone or self._past_planning() is not None
+                    else SEND_ATTEMPTS)
+        for attempt in range(1, attempts + 1):
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter('always')
                 self._send(response, header)
@@ -358,14 +373,16 @@ class PlannerNode(Node):
                     warnings.showwarning(other.message, other.category, other.filename,
                                          other.lineno)
             if not failed:
+                self._caller_gone = False
                 self.get_logger().debug('plan_sequence #%d: reply sent (client sequence '
                                         'number %d, attempt %d)' % (number, sequence, attempt))
                 return
             self.get_logger().error(
                 'plan_sequence #%d: reply (error code %d) not sent to the client (sequence '
                 'number %d), attempt %d of %d: %s'
-                % (number, response.error_code, sequence, attempt, SEND_ATTEMPTS,
+                % (number, response.error_code, sequence, attempt, attempts,
                    failed[0].message))
+        self._caller_gone = True
 
     def publish_answered(self) -> None:
         """

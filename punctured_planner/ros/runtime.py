@@ -79,6 +79,7 @@ thread still uses.
 """
 
 from dataclasses import dataclass
+import math
 import os
 import signal
 import sys
@@ -363,7 +364,7 @@ class ExecutorThreads:
             self._action_replied = True
         return now
 
-    def _answer_waiting(self, node: Node) -> None:
+    def _answer_waiting(self, node: Node, until: float = math.inf) -> None:
         """
         Answer the requests that reached the node's services and were not taken yet.
 
@@ -373,11 +374,15 @@ class ExecutorThreads:
         that comes while the participant lingers. A node past the stop's planning
         budget, or lingering, answers them quickly (NodeGroup.on_stop, Stop), so
         that many large requests cannot hold the stop past STOP_TIMEOUT_SEC and
-        every one is answered.
+        every one is answered. None is taken after ``until`` (time.monotonic()):
+        the linger's limit, which replies to callers that have gone (100 ms each)
+        had held for 90 s.
         """
         for service in node.services:
             srv_type: Any = service.srv_type  # a generated type: Request, Response
             for _ in range(SERVER_QOS.depth):
+                if time.monotonic() > until:
+                    return
                 with service.handle:
                     request, header = service.handle.service_take_request(srv_type.Request)
                 if header is None:
@@ -450,29 +455,29 @@ class ExecutorThreads:
         that keeps calling cannot hold the stop.
         """
         started = time.monotonic()
+        limit = started + LINGER_LIMIT_SEC
         if self._stop is not None:
             self._stop.lingering = True
-        self._answer_all()
+        self._answer_all(limit)
         if self._last_reply is None:
             return 0.0
-        limit = started + LINGER_LIMIT_SEC
         while (remaining := min(self._last_reply + REPLY_GRACE_SEC, limit)
                - time.monotonic()) > 0.0 and self._awaited():
             time.sleep(min(remaining, LINGER_POLL_SEC))
-            self._answer_all()
+            self._answer_all(limit)
         return time.monotonic() - started
 
-    def _answer_all(self) -> None:
+    def _answer_all(self, until: float) -> None:
         """
-        Answer what reached any node's services since its thread stopped (_answer_waiting).
+        Answer what reached any node's services since its thread stopped, until ``until``.
 
-        A callback that raises is logged and kept in :attr:`failure`, as in a
-        spin thread, and the stop goes on: every other node is still answered and
-        torn down.
+        _answer_waiting, node after node. A callback that raises is logged and kept
+        in :attr:`failure`, as in a spin thread, and the stop goes on: every other
+        node is still answered and torn down.
         """
         for node in self.nodes:
             try:
-                self._answer_waiting(node)
+                self._answer_waiting(node, until)
             except Exception as error:  # noqa: B902 - logged; the exit code says it
                 self.failure = self.failure or error
                 node.get_logger().error(_with_traceback('callback raised while stopping', error))
