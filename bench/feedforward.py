@@ -22,7 +22,6 @@ import os
 
 import execution as twenty_robots
 import numpy as np
-import yaml
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 CONFIG = os.path.join(os.path.dirname(HERE), 'config')
@@ -32,16 +31,15 @@ STEP = 0.05  # the executor's control period (s); the fleet steps at half of it
 
 def demo_scene():
     """Return (Reference, Bodies, tolerance, FleetSettings, ExecutionSettings) of make demo."""
+    from punctured_planner.cli import build_request
+    from punctured_planner.cli import load_request
     from punctured_planner.cli import offline_plan
     from punctured_planner.ros import conversions
-    from punctured_planner.ros.msg_dict import fill_message
     from punctured_planner.ros.parameters import load_parameter_file
     from punctured_planner.ros.settings import EXECUTOR
     from punctured_planner.ros.settings import FLEET_SIM
     from punctured_planner.ros.settings import PLANNER
-    from punctured_planner_interfaces.srv import PlanSequence
-    with open(os.path.join(CONFIG, 'demo_request.yaml'), encoding='utf-8') as stream:
-        request = yaml.safe_load(stream)
+    request = load_request(os.path.join(CONFIG, 'demo_request.yaml'))
     # each node's values as it reads the file (the shared section, then its own)
     planner, fleet, executor = (table.settings(load_parameter_file(
         os.path.join(CONFIG, 'demo.yaml'), table)) for table in (PLANNER, FLEET_SIM, EXECUTOR))
@@ -50,7 +48,7 @@ def demo_scene():
     request['configurations'].insert(0, {
         'header': request['configurations'][0]['header'],
         'poses': [{'position': dict(zip('xyz', map(float, p)))} for p in start]})
-    outcome = offline_plan(fill_message(PlanSequence.Request(), request), planner)
+    outcome = offline_plan(build_request(request), planner)
     assert outcome.ok, outcome
     message = conversions.plan_message(outcome, planner)
     return (conversions.plan_reference(message), conversions.plan_bodies(message),

@@ -215,11 +215,12 @@ def report(soak, elapsed, cpu):
     for index, seconds, rss, hwm in soak.memory:
         print('%8d %8.1f %10.1f %10.1f' % (index, seconds, rss, hwm))
     rss = np.array([m[2] for m in soak.memory])
-    # the second half's samples, at least two (a line through one is no slope)
-    half = min(len(rss) // 2, len(rss) - 2)
-    growth = ('%.3f MiB per 1000 calls' % (np.polyfit(
-        [m[0] for m in soak.memory[half:]], rss[half:], 1)[0] * 1000)
-              if half >= 0 else 'n/a (one sample: --every above --calls)')
+    if len(rss) < 2:  # a line through one sample is no slope
+        growth = 'n/a (one sample: --every above --calls)'
+    else:  # the second half's samples, at least two
+        half = min(len(rss) // 2, len(rss) - 2)
+        growth = '%.3f MiB per 1000 calls' % (np.polyfit(
+            [m[0] for m in soak.memory[half:]], rss[half:], 1)[0] * 1000)
     print('memory: start %.1f MiB, final %.1f MiB, peak (VmHWM) %.1f MiB, growth over the '
           'second half %s' % (rss[0], rss[-1], soak.memory[-1][3], growth))
     print('failures: %d' % len(soak.failures))

@@ -50,6 +50,7 @@ def ros_name(text: str) -> str:
     A name rclpy refuses raised from inside it, a traceback and exit 1 (the code of a
     planner error).
     """
+    from punctured_planner.ros.parameters import rcl_reason
     from rclpy.expand_topic_name import expand_topic_name
     from rclpy.validate_full_topic_name import validate_full_topic_name
     try:
@@ -57,7 +58,7 @@ def ros_name(text: str) -> str:
                                  is_service=True)
     except Exception as error:  # noqa: B902 - rclpy raises ValueError or its own kinds
         raise argparse.ArgumentTypeError('%r is not a valid ROS name: %s'
-                                         % (text, str(error).split(', at ')[0]))
+                                         % (text, rcl_reason(error)))
     return text
 
 
@@ -327,17 +328,21 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_INTERRUPTED
     except BrokenPipeError:
         # The reader closed the pipe (`... | head`): stop quietly, as Unix tools do.
-        # Standard output goes to /dev/null so the flush at exit cannot fail again.
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        _stdout_to_devnull()
         return EXIT_BROKEN_PIPE
     except OSError as error:  # standard output cannot be written (a full disk), or else
         with contextlib.suppress(OSError):  # nor, perhaps, standard error
             print('punctured-planner: %s' % error, file=sys.stderr)
         try:
             sys.stdout.flush()
-        except OSError:  # then the flush at exit would fail again: it goes to /dev/null
-            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        except OSError:
+            _stdout_to_devnull()
         return EXIT_USAGE
+
+
+def _stdout_to_devnull() -> None:
+    """Send standard output to /dev/null: the flush at exit cannot fail again."""
+    os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
 
 
 if __name__ == '__main__':

@@ -114,8 +114,10 @@ def test_a_signal_while_the_node_still_imports_stops_it_cleanly(ros_env, script)
                                     '__ns:=' + namespace], env=ros_env,
                                    stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
         try:
+            deadline = time.monotonic() + 60.0
             while '_rclpy_pybind11' not in _mapped(process.pid):
                 assert process.poll() is None, process.communicate()[0].decode()
+                assert time.monotonic() < deadline, 'rclpy never loaded'
                 time.sleep(0.002)
             process.send_signal(number)
             output = process.communicate(timeout=60)[0].decode()

@@ -132,15 +132,17 @@ def test_a_control_period_longer_than_the_hold_margin_is_named():
     three robots passed delta, by up to 33%, and nothing said so (msg_docs/ExecutePlan.md).
     """
     from punctured_planner.execution.hold import period_overrun
+    from punctured_planner.execution.unicycle import Corners
     # robot 0 at 0.5 m/s, robot 1 at 0.1 m/s; two poses at one stamp are skipped
     reference = reference_of([0.0, 2.0, 2.0, 4.0],
                              [[[0, 0, 0], [5, 0, 0]], [[1, 0, 0], [5, 0.2, 0]],
                               [[1, 0, 0], [5, 0.2, 0]], [[1, 1, 0], [5, 0.2, 0]]])
-    overrun = period_overrun(reference, 0.035, 0.6, 0.05)
+    corners = Corners(reference.seconds, reference.positions)
+    overrun = period_overrun(corners, 0.035, 0.6, 0.05)
     assert overrun.robots.tolist() == [0]
     assert overrun.distances == pytest.approx([0.025]) and overrun.margin == pytest.approx(0.014)
-    assert period_overrun(reference, 0.035, 0.6, 0.02).robots.size == 0  # 50 Hz: 0.01 m
-    assert period_overrun(reference, 0.035, 0.0, 0.05).robots.size == 0  # margin all of delta
+    assert period_overrun(corners, 0.035, 0.6, 0.02).robots.size == 0  # 50 Hz: 0.01 m
+    assert period_overrun(corners, 0.035, 0.0, 0.05).robots.size == 0  # margin all of delta
     # and afterwards, the robots whose error passed delta
     execution = Execution(reference, 0.035, ExecutionSettings(speed_limit=2.0))
     assert execution.beyond_tolerance().size == 0

@@ -583,6 +583,10 @@ def test_a_goal_starts_only_with_its_robots_at_rest(ros_client, lone_executor):
     timer = node.create_timer(0.05, report)
     try:
         plans.publish(message)
+        # the plan and the (moving) robots heard first: no start can be for want of them
+        assert ros_client.spin_until(
+            lambda: 'plan %d: 4 robots' % message.plan_id in executor.log() and all(
+                p.get_subscription_count() for p in odometry.values()), 10), executor.log()
         fed = []
         sent = action.send_goal_async(ExecutePlan.Goal(plan_id=message.plan_id),
                                       feedback_callback=fed.append)

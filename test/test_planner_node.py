@@ -487,18 +487,32 @@ def test_settings_the_obstacles_parameter_cannot_take_are_refused(planner, ros_c
 
 
 def plan_slowly(monkeypatch):
-    """Make every plan take 1.5 s more (in flight as a stop begins); return the Event it sets."""
+    """
+    Make every plan wait for a stop, and the outputs' thread's end; return the Event it sets.
+
+    The plan is in flight as the stop begins, and its reply goes out once the outputs'
+    thread has left its loop (planner_nodes, PlannerNode.note_stop; a fixed 1.5 s before).
+    """
     import threading
 
     import punctured_planner.core as core
-    taken = threading.Event()
-    real_plan = core.plan
+    from punctured_planner.nodes.planner import PlannerNode
+    taken, stopping = threading.Event(), threading.Event()
+    real_plan, real_note_stop = core.plan, PlannerNode.note_stop
+
+    def note_stop(self, stop):
+        real_note_stop(self, stop)
+        stopping.set()
 
     def slow_plan(*args, **kwargs):
         taken.set()
-        time.sleep(1.5)
+        assert stopping.wait(20), 'no stop'
+        for thread in threading.enumerate():
+            if thread.name.endswith('_outputs'):  # ExecutorThreads: 'spin <node>'
+                thread.join(20)
         return real_plan(*args, **kwargs)
 
+    monkeypatch.setattr(PlannerNode, 'note_stop', note_stop)
     monkeypatch.setattr(core, 'plan', slow_plan)
     return taken
 

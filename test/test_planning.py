@@ -1,6 +1,7 @@
 """One request against one snapshot (ros.planning.PlanSequenceHandler), without DDS."""
 
 import numpy as np
+from planner_helpers import flat
 from planner_helpers import make_request
 from planner_helpers import OBSTACLES
 from punctured_planner.core import ErrorCode
@@ -21,7 +22,7 @@ def snapshot(**values):
 def test_planner_caches_one_workspace_per_obstacle_set():
     from punctured_planner_interfaces.srv import PlanSequence
     planner = PlanSequenceHandler()
-    base = snapshot(obstacles=[v for o in OBSTACLES for v in o])
+    base = snapshot(obstacles=flat(OBSTACLES))
     first = planner.workspace(base.settings, np.array(OBSTACLES)[:, :2])
     assert planner.workspace(base.settings, np.array(OBSTACLES)[:, :2]) is first
     paper = PLANNER.settings({'variant': 'paper'})
@@ -63,38 +64,37 @@ def test_discs_answers_over_max_poses_are_refused_once_planned():
     no pose (this request has such legs), so an answer of exactly max_poses is given.
     """
     from punctured_planner_interfaces.srv import PlanSequence
-    flat = [v for o in OBSTACLES for v in o]
     planned = PlanSequenceHandler().handle(
         make_request(), PlanSequence.Response(),
-        snapshot(obstacles=flat, robot_radius=0.1, samples_per_leg=0), 0)
+        snapshot(obstacles=flat(OBSTACLES), robot_radius=0.1, samples_per_leg=0), 0)
     poses = answer_poses(planned)
     assert poses < 4 * len(planned.plan.times)
-    limited = snapshot(obstacles=flat, robot_radius=0.1, samples_per_leg=0,
+    limited = snapshot(obstacles=flat(OBSTACLES), robot_radius=0.1, samples_per_leg=0,
                        max_poses=poses - 1)
     outcome = PlanSequenceHandler().handle(make_request(), PlanSequence.Response(), limited, 0)
     assert outcome.response.error_code == PlanSequence.Response.REQUEST_OVER_LIMITS
     assert 'more than max_poses %d' % (poses - 1) in outcome.response.error_msg
-    enough = snapshot(obstacles=flat, robot_radius=0.1, samples_per_leg=0, max_poses=poses)
+    enough = snapshot(obstacles=flat(OBSTACLES), robot_radius=0.1, samples_per_leg=0,
+                      max_poses=poses)
     assert PlanSequenceHandler().handle(make_request(), PlanSequence.Response(), enough, 0).ok
 
 
 def test_refined_answers_are_checked_by_their_own_pose_count():
     """The refinement adds knots: max_poses is checked against the refined plan's poses."""
     from punctured_planner_interfaces.srv import PlanSequence
-    flat = [v for o in OBSTACLES for v in o]
     raw = PlanSequenceHandler().handle(make_request(), PlanSequence.Response(),
-                                       snapshot(obstacles=flat, refine=False), 0)
+                                       snapshot(obstacles=flat(OBSTACLES), refine=False), 0)
     refined = PlanSequenceHandler().handle(make_request(), PlanSequence.Response(),
-                                           snapshot(obstacles=flat), 0)
+                                           snapshot(obstacles=flat(OBSTACLES)), 0)
     assert raw.ok and refined.ok and raw.plan.raw is None and refined.plan.raw is not None
     poses = answer_poses(refined)
     assert answer_poses(raw) < poses
     # Enough for the construction's breakpoints, not for the refined plan's.
-    limited = snapshot(obstacles=flat, max_poses=poses - 1)
+    limited = snapshot(obstacles=flat(OBSTACLES), max_poses=poses - 1)
     outcome = PlanSequenceHandler().handle(make_request(), PlanSequence.Response(), limited, 0)
     assert outcome.response.error_code == PlanSequence.Response.REQUEST_OVER_LIMITS
     assert 'more than max_poses %d' % (poses - 1) in outcome.response.error_msg
-    enough = snapshot(obstacles=flat, max_poses=poses)
+    enough = snapshot(obstacles=flat(OBSTACLES), max_poses=poses)
     assert PlanSequenceHandler().handle(make_request(), PlanSequence.Response(), enough, 0).ok
 
 
@@ -109,14 +109,14 @@ def test_max_poses_leaves_out_what_the_current_state_drops():
     """
     from punctured_planner.ros.snapshot import RobotState
     from punctured_planner_interfaces.srv import PlanSequence
-    flat = [v for o in OBSTACLES for v in o]
     start, goal = make_request().configurations[:2]
     state = RobotState(conversions.pose_array_positions(start), np.tile([0.0, 0, 0, 1], (4, 1)),
                        'map', 5, 'robot_states', 5)
     request = make_request()
     request.configurations = [start] * 10 + [goal]
     request.use_current_state = True
-    values = {'obstacles': flat, 'variant': 'paper', 'samples_per_leg': 0, 'refine': False}
+    values = {'obstacles': flat(OBSTACLES), 'variant': 'paper', 'samples_per_leg': 0,
+              'refine': False}
     settings = PLANNER.settings(values)
     obstacles = ObstacleSet(conversions.obstacles_from_parameter(settings.obstacles))
     planned = PlanSequenceHandler().handle(request, PlanSequence.Response(),
@@ -142,7 +142,7 @@ def test_a_plan_refused_for_the_resolution_reports_the_gap_it_found():
     far[1][2][0] = 1e15
     outcome = PlanSequenceHandler().handle(
         make_request(far), PlanSequence.Response(),
-        snapshot(obstacles=[v for o in OBSTACLES for v in o]), 0)
+        snapshot(obstacles=flat(OBSTACLES)), 0)
     response = outcome.response
     assert response.error_code == PlanSequence.Response.CLEARANCE_BELOW_REQUIRED
     assert 'numerical resolution' in response.error_msg
@@ -152,13 +152,12 @@ def test_a_plan_refused_for_the_resolution_reports_the_gap_it_found():
 def test_stamps_past_2038_name_the_limit_that_binds():
     """A motion too long for the stamps under a tiny max_acceleration says to raise that."""
     from punctured_planner_interfaces.srv import PlanSequence
-    flat = [v for o in OBSTACLES for v in o]
     for max_acceleration, culprit in ((1e-20, 'raise max_acceleration'),
                                       (0.0, 'raise max_speed')):
         outcome = PlanSequenceHandler().handle(
             make_request(max_speed=1e-12 if max_acceleration == 0.0 else 1.0),
             PlanSequence.Response(),
-            snapshot(obstacles=flat, max_acceleration=max_acceleration), 0)
+            snapshot(obstacles=flat(OBSTACLES), max_acceleration=max_acceleration), 0)
         assert outcome.response.error_code == PlanSequence.Response.INVALID_REQUEST
         assert outcome.response.error_msg.endswith(culprit), outcome.response.error_msg
 
@@ -174,7 +173,7 @@ def test_a_request_no_answer_of_which_fits_is_refused_before_planning(monkeypatc
     request = make_request(samples_per_leg=100)  # 4 robots, 1 + 101 per segment at least
     outcome = PlanSequenceHandler().handle(
         request, PlanSequence.Response(),
-        snapshot(obstacles=[v for o in OBSTACLES for v in o], max_poses=400), 0)
+        snapshot(obstacles=flat(OBSTACLES), max_poses=400), 0)
     assert outcome.response.error_code == PlanSequence.Response.REQUEST_OVER_LIMITS
     assert 'more than max_poses 400' in outcome.response.error_msg
 
@@ -195,7 +194,7 @@ def test_array_holding_dataclasses_compare_by_identity():
 def state_snapshot(positions, received_ns, **values):
     """Return a snapshot with the example obstacles and a robot state received then."""
     from punctured_planner.ros.snapshot import RobotState
-    settings = PLANNER.settings({'obstacles': [v for o in OBSTACLES for v in o], **values})
+    settings = PLANNER.settings({'obstacles': flat(OBSTACLES), **values})
     state = RobotState(np.asarray(positions, dtype=float), np.zeros((len(positions), 4)),
                        'map', received_ns - 7, 'robot_states', received_ns)
     return Snapshot(settings, ObstacleSet(np.array(OBSTACLES)), state)
@@ -412,15 +411,14 @@ def test_no_obstacles_plan_whatever_the_per_obstacle_radii():
 def test_a_request_faster_than_the_parameters_range_is_refused():
     """max_speed 1e9: INVALID_REQUEST (its stamps, 1 ns apart, spanned 68 ns for 5 ns)."""
     from punctured_planner_interfaces.srv import PlanSequence
-    flat = [v for o in OBSTACLES for v in o]
     for speed in (1e9, 1e300):
         outcome = PlanSequenceHandler().handle(make_request(max_speed=speed),
                                                PlanSequence.Response(),
-                                               snapshot(obstacles=flat), 0)
+                                               snapshot(obstacles=flat(OBSTACLES)), 0)
         assert outcome.response.error_code == PlanSequence.Response.INVALID_REQUEST
         assert 'at most 1e+06 m/s' in outcome.response.error_msg
     assert PlanSequenceHandler().handle(make_request(max_speed=1e6), PlanSequence.Response(),
-                                        snapshot(obstacles=flat), 0).ok
+                                        snapshot(obstacles=flat(OBSTACLES)), 0).ok
 
 
 def test_free_text_in_a_message_is_never_read_as_a_slot():

@@ -112,6 +112,30 @@ def test_requests_waiting_while_the_node_is_stopped_are_all_answered(
     node.assert_running()
 
 
+def deaf_and_served(planner_process, clients):
+    """
+    Start the node; return it, a request, a deaf and a served client (ros, client) each.
+
+    The deaf client's replies never reach it: its transient-local requests match the
+    node's volatile request reader, but the node's volatile reply writer never matches
+    its transient-local reply reader. The served client has had one reply.
+    """
+    from punctured_planner.ros.qos import CLIENT_QOS
+    from punctured_planner_interfaces.srv import PlanSequence
+    from rclpy.qos import DurabilityPolicy
+    from rclpy.qos import QoSProfile
+    node = planner_process(params_file=SCENARIO)
+    request = example_request()
+    deaf = clients('deaf')
+    deaf_client = deaf.node.create_client(
+        PlanSequence, node.name('plan_sequence'),
+        qos_profile=QoSProfile(depth=10, durability=DurabilityPolicy.TRANSIENT_LOCAL))
+    served = clients('served')
+    served_client = plan_client(served, node, CLIENT_QOS)
+    assert served.call(served_client, request).error_code == PlanSequence.Response.NONE
+    return node, request, deaf, deaf_client, served, served_client
+
+
 def test_every_reply_that_cannot_be_sent_is_an_error_naming_its_request(
         planner_process, clients):
     """
@@ -122,31 +146,26 @@ def test_every_reply_that_cannot_be_sent_is_an_error_naming_its_request(
     sending held the service's thread 1.1 s each (doc/design.md section 15).
     """
     from punctured_planner.nodes.planner import SEND_ATTEMPTS
-    from punctured_planner.ros.qos import CLIENT_QOS
     from punctured_planner_interfaces.srv import PlanSequence
-    from rclpy.qos import DurabilityPolicy
-    from rclpy.qos import QoSProfile
-    node = planner_process(params_file=SCENARIO)
-    request = example_request()
-    # Transient-local requests match the node's volatile request reader; the node's
-    # volatile reply writer never matches a transient-local reply reader.
-    unmatched = QoSProfile(depth=10, durability=DurabilityPolicy.TRANSIENT_LOCAL)
-    deaf = clients('deaf')
-    deaf_client = deaf.node.create_client(PlanSequence, node.name('plan_sequence'),
-                                          qos_profile=unmatched)
-    served = clients('served')
-    served_client = plan_client(served, node, CLIENT_QOS)
-    assert served.call(served_client, request).error_code == PlanSequence.Response.NONE
+    node, request, deaf, deaf_client, served, served_client = deaf_and_served(
+        planner_process, clients)
     futures = []
 
     def unsent(number, attempts):
-        """Send deaf requests until request #number is taken; wait for its last attempt."""
-        while 'plan_sequence #%d: ' % number not in node.log():
+        """
+        Send a deaf request taken as #number; wait for its last attempt.
+
+        Sent again only while none is taken: one sent before the deaf client matched
+        the node is lost, and one more taken would shift the numbers.
+        """
+        taken = 'plan_sequence #%d: ' % number
+        while taken not in node.log():
             futures.append(deaf_client.call_async(request))
-            deaf.spin_until(lambda: False, 0.5)
+            deaf.spin_until(lambda: taken in node.log(), 5.0)
         last = 'plan_sequence #%d: reply (error code 0) not sent to the client' % number
-        assert deaf.spin_until(lambda: ('attempt %d of %d' % (attempts, attempts)) in
-                               node.log().split(last)[-1], 10.0), node.log()
+        assert deaf.spin_until(lambda: last in node.log() and (
+            'attempt %d of %d' % (attempts, attempts)) in node.log().split(last)[-1],
+            10.0), node.log()
 
     unsent(2, SEND_ATTEMPTS)
     unsent(3, 1)  # the caller of #2 had gone: one attempt
@@ -173,21 +192,11 @@ def test_callers_that_have_gone_cannot_hold_the_stop(planner_process, clients):
     linger 90 s (doc/design.md section 16).
     """
     from punctured_planner.nodes.planner import SEND_ATTEMPTS
-    from punctured_planner.ros.qos import CLIENT_QOS
-    from punctured_planner_interfaces.srv import PlanSequence
-    from rclpy.qos import DurabilityPolicy
-    from rclpy.qos import QoSProfile
-    node = planner_process(params_file=SCENARIO)
-    request = example_request()
-    deaf = clients('deaf')
-    deaf_client = deaf.node.create_client(
-        PlanSequence, node.name('plan_sequence'),
-        qos_profile=QoSProfile(depth=10, durability=DurabilityPolicy.TRANSIENT_LOCAL))
-    served = clients('served')  # stays a client: the stop lingers for it
-    served_client = plan_client(served, node, CLIENT_QOS)
-    assert served.call(served_client, request).error_code == PlanSequence.Response.NONE
+    from punctured_planner.ros.runtime import LINGER_LIMIT_SEC, STOP_TIMEOUT_SEC
+    # the served client stays a client: the stop lingers for it
+    node, request, deaf, deaf_client, _, _ = deaf_and_served(planner_process, clients)
     node.proc.send_signal(signal.SIGINT)
-    deadline = time.monotonic() + 40.0
+    deadline = time.monotonic() + STOP_TIMEOUT_SEC + LINGER_LIMIT_SEC
     while node.proc.poll() is None and time.monotonic() < deadline:
         deaf_client.call_async(request)
         deaf.spin_until(lambda: False, 0.02)

@@ -237,13 +237,15 @@ class PillarClearance:
 
     reach w_j = R + rho_j + mu_j; pitch g the slots' and lanes'; clear_j how far
     beyond pillar j's centre along e2 the fleet stages (top, DiscLayout): above its
-    zone, and as far above the pillar as the slots keep robots apart.
+    zone, and as far above the pillar as the slots keep robots apart; robot_radius
+    the R they are for.
     """
 
     reach: np.ndarray
     apart: float
     pitch: float
     clear: np.ndarray
+    robot_radius: float
 
     @classmethod
     def from_radii(cls, robot_radius: float, obstacle_radius: np.ndarray,
@@ -259,7 +261,7 @@ class PillarClearance:
         pitch = max(min_spacing, apart)
         # A robot staged clear of pillar j passes it with at least the slots' gap g - 2R.
         clear = np.maximum(ZONE * reach, obstacle_radius + pitch - robot_radius)
-        return cls(reach, apart, pitch, clear)
+        return cls(reach, apart, pitch, clear, robot_radius)
 
 
 @dataclass(frozen=True, eq=False)
@@ -290,14 +292,15 @@ class DiscLayout:
     walls: WallRoom | None
 
     @classmethod
-    def from_sizes(cls, frame: Frame, obstacles: np.ndarray, robot_radius: float,
-                   sizes: PillarClearance, bounds: np.ndarray | None = None) -> 'DiscLayout':
+    def from_sizes(cls, frame: Frame, obstacles: np.ndarray, sizes: PillarClearance,
+                   bounds: np.ndarray | None = None) -> 'DiscLayout':
         """
-        Return the layout for pillars (r, d) of sizes (PillarClearance), robots of radius R.
+        Return the layout for pillars (r, d) of sizes (PillarClearance, robots of radius R).
 
         bounds (d, 2), or None for no walls, give the room the walls leave (WallRoom).
         """
-        reach, apart, pitch = sizes.reach, sizes.apart, sizes.pitch
+        reach, apart, pitch, robot_radius = (sizes.reach, sizes.apart, sizes.pitch,
+                                             sizes.robot_radius)
         offsets = frame.offset(obstacles)
         # Above every pillar's clearance (PillarClearance).
         top = float((offsets + sizes.clear).max()) if len(obstacles) else 0.0

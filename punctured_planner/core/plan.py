@@ -330,11 +330,15 @@ class Plan:
         """Return how many breakpoints sample keeps in stamps: the answer's count, unsampled."""
         return int(self._distinct(self.stamps(max_speed, max_acceleration)).sum())
 
+    @cached_property
+    def _moved(self) -> np.ndarray:
+        """Return the (V - 1,) mask of breakpoints whose poses differ from the one before."""
+        return (self.positions[1:] != self.positions[:-1]).any(axis=(1, 2))
+
     def _distinct(self, values: np.ndarray) -> np.ndarray:
         """Return the (V,) mask of breakpoints kept: the first, then each new in value or pose."""
         new = np.ones(values.size, dtype=bool)
-        new[1:] = (values[1:] != values[:-1]) | (
-            self.positions[1:] != self.positions[:-1]).any(axis=(1, 2))
+        new[1:] = (values[1:] != values[:-1]) | self._moved
         return new
 
 

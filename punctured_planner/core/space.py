@@ -157,9 +157,8 @@ class Workspace:
         With bodies, a required gap c is planned for by inflating every body by
         c / 2: a gap >= 0 between the inflated bodies is a gap >= c between the real ones.
         """
-        return DiscLayout.from_sizes(self.frame, self.obstacles,
-                                     self.robot_radius + self._inflation(),
-                                     self._pillar_clearance, self.bounds)
+        return DiscLayout.from_sizes(self.frame, self.obstacles, self._pillar_clearance,
+                                     self.bounds)
 
     @cached_property
     def _pillar_clearance(self) -> PillarClearance:
@@ -187,7 +186,7 @@ class Workspace:
         if self.bounds is None:
             return choose_frame(self.obstacles, oblique=True, robot_radius=self.robot_radius)
         return choose_frame(self.obstacles, self.bounds, oblique=True,
-                            robot_radius=self.robot_radius + self._inflation(),
+                            robot_radius=self._pillar_clearance.robot_radius,
                             clearance=self._pillar_clearance.clear)
 
 

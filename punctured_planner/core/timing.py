@@ -61,9 +61,15 @@ def length_times(positions: np.ndarray, waypoint_indices: np.ndarray) -> np.ndar
     return times
 
 
+def _positive_finite(*limits: float | np.ndarray) -> bool:
+    """Return whether every limit (a number or an array of them) is positive and finite."""
+    return all(bool(np.all((np.asarray(limit) > 0) & (np.asarray(limit) < np.inf)))
+               for limit in limits)
+
+
 def breakpoint_stamps(positions: np.ndarray, max_speed: float) -> np.ndarray:
     """Return (V,) seconds from the start at which the robots reach each breakpoint."""
-    if not 0 < max_speed < np.inf:
+    if not _positive_finite(max_speed):
         raise ValueError('max_speed must be positive and finite')
     stamps = np.zeros(len(positions))
     np.add.accumulate(leg_lengths(positions) / max_speed, out=stamps[1:])
@@ -190,7 +196,7 @@ def speed_profile(positions: np.ndarray, max_speed: float, max_acceleration: flo
     jump / Delta, so no robot's velocity jumps by more than jump. A forward and
     a backward pass make every breakpoint speed reachable within its legs.
     """
-    if not (0 < max_speed < np.inf and 0 < max_acceleration < np.inf):
+    if not _positive_finite(max_speed, max_acceleration):
         raise ValueError('max_speed and max_acceleration must be positive and finite')
     lengths = leg_lengths(positions)
     speeds = _breakpoint_speeds(positions, lengths, np.full(len(lengths), float(max_speed)),
@@ -223,8 +229,7 @@ def fleet_profile(positions: np.ndarray, max_speeds: np.ndarray,
     """
     max_speeds = np.asarray(max_speeds, dtype=float)
     max_accelerations = np.asarray(max_accelerations, dtype=float)
-    if not (np.all((max_speeds > 0) & (max_speeds < np.inf))
-            and np.all((max_accelerations > 0) & (max_accelerations < np.inf))):
+    if not _positive_finite(max_speeds, max_accelerations):
         raise ValueError('every max_speed and max_acceleration must be positive and finite')
     lengths = leg_lengths(positions)
     steps = np.linalg.norm(np.diff(positions, axis=0), axis=2)

@@ -318,10 +318,14 @@ class Execution:
                        self._differential_cap(alpha))
             allowed = 0.0 if stale.any() else min(seen, clock_rate(
                 watched, self.tolerance, s.slow_fraction, s.hold_fraction))
-            # what stale or old odometry may hide brakes the clock (a rate below the one
-            # before, so no rise is left); what it shows may hold it
-            change = self._rate_change(motion)
-            rate = self._rate_rise(min(seen, self._braked(allowed, dt, change)), dt, change)
+            if self.reference.profile is None:  # no acceleration limit: the rate at once
+                rate = min(seen, allowed)
+            else:
+                # what stale or old odometry may hide brakes the clock (a rate below the
+                # one before, so no rise is left); what it shows may hold it
+                change = self._rate_change(motion)
+                rate = self._rate_rise(min(seen, self._braked(allowed, dt, change)), dt,
+                                       change)
         self.rate = rate
         duration = self.reference.duration
         self.plan_time = min(duration, self.plan_time + rate * dt)
@@ -413,11 +417,9 @@ class Execution:
         Under acceleration limits the clock rises no faster than change (_rate_change):
         released from a hold at once, a robot limited to a_i would lag its
         reference's jump by up to v^2 / (2 a_i) and hold the clock again. It
-        still slows and holds at once for the robots' errors. A plan without
-        the limit keeps the clock's rate as it is.
+        still slows and holds at once for the robots' errors. (A plan without the
+        limit takes its rate at once: step.)
         """
-        if self.reference.profile is None:
-            return wanted
         return min(wanted, self.rate + change * dt)
 
     def _braked(self, wanted: float, dt: float, change: float) -> float:
@@ -427,15 +429,13 @@ class Execution:
         For what odometry does not show: a robot's stale odometry (wanted 0), and
         what a robot may have moved since its odometry (_late), which grows as
         fast as the robot goes once its odometry stops and had held the clock
-        within 0.25 s, before the robot even counted as stale. Without an
-        acceleration limit the clock follows wanted at once. Under one it brakes
+        within 0.25 s, before the robot even counted as stale. Under the plan's
+        acceleration limit (without one the clock follows wanted at once: step) it brakes
         no faster than change (_rate_change), every robot following its braking reference,
         a stale one on its feed-forward alone (step): held at once, each robot at
         v overran its stopped reference by v^2 / (2 a_i) (a probe over DDS: 0.26 m
         against a tolerance of 0.15 m at 0.75 m/s and 1 m/s^2).
         """
-        if self.reference.profile is None:
-            return wanted
         return max(wanted, self.rate - change * dt)
 
     def _feedforward(self, rate: float, dt: float, lags: np.ndarray,

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .reference import Reference
+from .unicycle import Corners
 
 # The clock counts as held below this rate. Near the hold threshold it slows in
 # proportion to the room left, so a robot that cannot move makes the rate tend to 0
@@ -66,7 +67,7 @@ class Overrun:
     margin: float
 
 
-def period_overrun(reference: Reference, tolerance: float, hold_fraction: float,
+def period_overrun(corners: Corners, tolerance: float, hold_fraction: float,
                    period: float) -> Overrun:
     """
     Return the robots whose reference moves farther in one period than the hold's margin.
@@ -75,13 +76,10 @@ def period_overrun(reference: Reference, tolerance: float, hold_fraction: float,
     tolerance: a robot that stops following falls behind by up to what its reference
     moves in one period (and its command latency) before that, which the rest of
     the tolerance must cover (msg_docs/ExecutePlan.md). Speeds are each stamp
-    interval's mean, a profiled reference's peak higher: a lower bound.
+    interval's mean (corners: the reference's, Execution.corners), a profiled
+    reference's peak higher: a lower bound.
     """
-    durations = np.diff(reference.seconds)
-    moving = durations > 0
-    moves = np.linalg.norm(np.diff(reference.positions, axis=0), axis=2)[moving]
-    speeds = (moves / durations[moving, None]).max(axis=0, initial=0.0)
-    travel = speeds * period
+    travel = corners.speeds.max(axis=0, initial=0.0) * period
     margin = (1.0 - hold_fraction) * tolerance
     robots = np.flatnonzero(travel > margin)
     return Overrun(robots, travel[robots], margin)

@@ -499,7 +499,7 @@ class PlanExecutor(Node):
                                'the robots)' % (plan.plan_id, len(plan.names),
                                                 plan.reference.duration,
                                                 execution.reference.duration))
-        overrun = period_overrun(execution.reference, plan.tolerance, settings.hold_fraction,
+        overrun = period_overrun(execution.corners, plan.tolerance, settings.hold_fraction,
                                  1.0 / settings.control_rate)
         if overrun.robots.size:
             self.get_logger().warning(

@@ -7,25 +7,27 @@ a stop signal in between stops the node as soon as it runs, exit 0. ``python -m
 punctured_planner.nodes.<node>`` runs the same ``main`` without that first note.
 """
 
+import importlib
+
 from ..ros import early_signals
+
+
+def _run(node: str) -> int:
+    """Note the stop signals, then import the node's module and run its main."""
+    early_signals.note_from_now()
+    return importlib.import_module('.' + node, __package__).main()
 
 
 def planner_node() -> int:
     """Run the planner node of punctured_planner.nodes.planner."""
-    early_signals.note_from_now()
-    from .planner import main
-    return main()
+    return _run('planner')
 
 
 def plan_executor() -> int:
     """Run the plan executor of punctured_planner.nodes.executor."""
-    early_signals.note_from_now()
-    from .executor import main
-    return main()
+    return _run('executor')
 
 
 def fleet_sim() -> int:
     """Run the simulated fleet of punctured_planner.nodes.fleet_sim."""
-    early_signals.note_from_now()
-    from .fleet_sim import main
-    return main()
+    return _run('fleet_sim')

@@ -178,11 +178,12 @@ def normalized_quaternions(quaternions: npt.ArrayLike) -> np.ndarray:
         # A finite one whose squares overflow (1e200) or underflow (1e-170) is scaled by
         # its largest component first, not taken for a non-finite or zero one.
         extreme = ~((norms > _SMALLEST_SAFE_NORM) & (norms < _LARGEST_SAFE_NORM))
-        largest = np.abs(quaternions).max(axis=-1, keepdims=True)
-        scale = np.where(extreme & (largest > 0) & np.isfinite(largest), largest, 1.0)
-        quaternions = quaternions / scale
-        norms = np.where(extreme, np.sqrt(np.add.reduce(quaternions * quaternions, axis=-1,
-                                                        keepdims=True)), norms)
+        if extreme.any():  # rare: a received plan's 2 M poses took 0.31 s, not 0.11 s
+            largest = np.abs(quaternions).max(axis=-1, keepdims=True)
+            scale = np.where(extreme & (largest > 0) & np.isfinite(largest), largest, 1.0)
+            quaternions = quaternions / scale
+            norms = np.where(extreme, np.sqrt(np.add.reduce(
+                quaternions * quaternions, axis=-1, keepdims=True)), norms)
         good = np.isfinite(norms) & (norms > 0)
         result = np.where(good, quaternions / np.where(good, norms, 1.0), IDENTITY)
     return result

@@ -34,11 +34,8 @@ from rcl_interfaces.msg import ParameterType
 from rcl_interfaces.msg import SetParametersResult
 import yaml
 
-from .topics import CMD_VEL
-from .topics import ODOM
-from .topics import PLAN
-from .topics import REFERENCE_POSE
 from .topics import robot_topic
+from .topics import ROBOT_TOPICS
 from ..core.limits import length_range
 from ..core.limits import lengths_in_range
 
@@ -479,7 +476,7 @@ class NodeParameters(Generic[S]):
                                            'no valid topic names in namespace %s: %s'
                                            % (spec.name, index, robot,
                                               self._node.get_namespace(),
-                                              str(error).split(', at ')[0]),
+                                              rcl_reason(error)),
                                            index=index) from None
 
     def _after_set(self, parameters: list) -> None:
@@ -500,7 +497,9 @@ class NodeParameters(Generic[S]):
 
 
 # The longest of a robot's topic names (ros.topics): if it resolves, every one does.
-_LONGEST_ROBOT_TOPIC = max((PLAN, ODOM, CMD_VEL, REFERENCE_POSE), key=len)
+_LONGEST_ROBOT_TOPIC = max(ROBOT_TOPICS, key=len)
+# The section names that stand for any node (and, '**', any namespace too).
+_WILDCARDS = ('*', '**')
 # Parameters rclpy declares on every node: a file may set them; they are not ours.
 RCLPY_PARAMETERS = ('use_sim_time', 'start_type_description_service')
 
@@ -533,6 +532,11 @@ def _no_section(table: Table, namespace: str | None = None) -> str:
                                                        table.node_name)
 
 
+def rcl_reason(error: BaseException) -> str:
+    """Return rcl's (or rclpy's) error text without its source locations (', at ...')."""
+    return str(error).split(', at ')[0]
+
+
 def _section_pattern(key: str) -> re.Pattern:
     """
     Return the full node names a section key applies to, as rcl reads the key.
@@ -544,6 +548,11 @@ def _section_pattern(key: str) -> re.Pattern:
     return re.compile(''.join(tokens))
 
 
+def _node_of(key: str) -> str:
+    """Return the node name a section key ends with (a wildcard for every node)."""
+    return key.rstrip('/').split('/')[-1]
+
+
 def _applies(key: str, node_name: str, namespace: str | None) -> bool:
     """
     Return whether the section key applies to node_name in namespace.
@@ -552,7 +561,7 @@ def _applies(key: str, node_name: str, namespace: str | None) -> bool:
     key's last name is the node's or a wildcard.
     """
     if namespace is None:
-        return key.rstrip('/').split('/')[-1] in (node_name, '*', '**')
+        return _node_of(key) in (node_name, *_WILDCARDS)
     full_name = '/'.join(['', *namespace.strip('/').split('/'), node_name]).replace('//', '/')
     return _section_pattern(key).fullmatch(full_name) is not None
 
@@ -606,7 +615,7 @@ def read_parameter_file(path: str, table: Table,
         if not _applies(key, table.node_name, namespace):
             continue
         # a section for every node (its name a wildcard) holds other nodes' parameters too
-        shared = key.rstrip('/').split('/')[-1] in ('*', '**')
+        shared = _node_of(key) in _WILDCARDS
         applied = True
         parameters = section['ros__parameters'] or {}
         if not isinstance(parameters, dict):

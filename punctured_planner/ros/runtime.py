@@ -110,6 +110,7 @@ from rclpy.task import Future
 
 from .early_signals import STOP_SIGNALS
 from .early_signals import take_noted
+from .parameters import rcl_reason
 from .parameters import Table
 from .qos import load_fastdds_profile
 from .qos import SERVER_QOS
@@ -538,8 +539,7 @@ def run_nodes(process: Table | str, make_nodes: Callable[[Context], NodeGroup],
             print('%s: invalid parameters: %s' % (name, error), file=sys.stderr)
             return EXIT_BAD_PARAMETERS
         except RCLError as error:  # arguments rcl refuses
-            # rcl's reason without its source locations (', at /project/src/...')
-            print('%s: cannot start: %s' % (name, str(error).split(', at ')[0]),
+            print('%s: cannot start: %s' % (name, rcl_reason(error)),
                   file=sys.stderr)
             return EXIT_BAD_PARAMETERS
         try:

@@ -12,6 +12,8 @@ ODOM = 'odom'
 # The executor's commands to a robot, and the reference they track.
 CMD_VEL = 'cmd_vel'
 REFERENCE_POSE = 'reference_pose'
+# Every topic a robot has.
+ROBOT_TOPICS = (PLAN, ODOM, CMD_VEL, REFERENCE_POSE)
 
 
 def robot_topic(robot: str, topic: str) -> str:
