@@ -158,11 +158,8 @@ class PlanSequenceHandler:
         topic, when other settings change, the core's Workspace rule (check_workspace:
         its obstacle_radius count, obstacles beyond workspace_bounds), so no change is
         taken that would refuse every request. So plane_z or frame_id may change first
-        and the obstacles follow. An empty set is not checked: per-obstacle radii may
-        wait for the topic's set.
+        and the obstacles follow.
         """
-        if not len(obstacles.points):
-            return
         try:
             (self.check_obstacles if 'obstacles' in changed
              else self.check_workspace)(settings, obstacles)
