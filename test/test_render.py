@@ -249,6 +249,8 @@ def test_command_line_and_wiring(tmp_path, capsys):
     # refused with the reason: PNG bytes named .gif, nothing to draw, no such folder
     with pytest.raises(SystemExit):
         main(['domain', str(tmp_path / 'd.gif')])
+    assert "d.gif': the picture is written as a .png file" in capsys.readouterr().err
+    assert not (tmp_path / 'd.gif').exists()
     with pytest.raises(SystemExit):
         main(['example'])
     assert 'give --png OUT.png and/or --gif OUT.gif' in capsys.readouterr().err
