@@ -162,8 +162,8 @@ class StopSignals:
     a stop signal came: then both stay ignored, as the process is on its way out (a
     second Ctrl-C or SIGTERM in its last 0.2 s of teardown killed it, exit -2 or -15).
     A stop signal noted while the process started (:mod:`.early_signals`) wakes
-    :meth:`wait` at once. Enter it from the main thread (Python sets signal handlers
-    only there).
+    :meth:`wait` at once; ``while_starting`` lists those signals. Enter it from the
+    main thread (Python sets signal handlers only there).
     """
 
     def __init__(self) -> None:
@@ -172,6 +172,7 @@ class StopSignals:
         self._previous_fd = -1
         self._read_fd = self._write_fd = -1
         self._stopped = False
+        self.while_starting: list[int] = []
 
     def __enter__(self) -> 'StopSignals':
         """Install the handlers and the wake-up pipe."""
@@ -180,7 +181,8 @@ class StopSignals:
         self._previous_fd = signal.set_wakeup_fd(self._write_fd, warn_on_full_buffer=False)
         for number in STOP_SIGNALS:
             self._previous[number] = signal.signal(number, _ignore)
-        for noted in take_noted():  # a stop signal while the process started
+        self.while_starting = take_noted()  # stop signals while the process started
+        for noted in self.while_starting:
             os.write(self._write_fd, bytes([noted]))
         return self
 
@@ -552,6 +554,10 @@ def run_nodes(process: Table | str, make_nodes: Callable[[Context], NodeGroup],
                                       before_stop=group.before_stop,
                                       on_stop=group.on_stop)
             threads.start()
+            if signals.while_starting:  # why a node that just started stops at once
+                group.nodes[0].get_logger().info('%s came while the process started: '
+                                                 'stopping' % signal.Signals(
+                                                     signals.while_starting[0]).name)
             signals.wait()
             _teardown(threads, group, timeout_sec)
         finally:
