@@ -8,6 +8,7 @@ changes. The client is the ``ros_client`` fixture (another Context).
 
 import gc
 import math
+import threading
 import time
 
 from conftest import RosClient
@@ -706,6 +707,49 @@ def test_odometry_assembles_the_current_state(planner, ros_client):
                                                     use_current_state=True))
     assert response.error_code == plan_sequence.Response.FRAME_MISMATCH
     assert 'current robot state' in response.error_msg
+
+
+def test_robot_names_change_the_subscriptions_in_the_inputs_thread(planner, ros_client):
+    """
+    robot_names set to 300 robots and back: the subscriptions change in the inputs' thread.
+
+    The odometry of the robots kept still assembles the state. The parameters' thread
+    destroyed them while the inputs' executor built its wait set from them: InvalidHandle
+    there stopped the node (exit 1), intermittently.
+    """
+    odometry = _types()[5]
+    names = ['r0', 'r1']
+    node = planner(obstacles=flat(OBSTACLES), robot_names=names)
+    inputs = node.node.inputs
+    changed_in = []
+    for method in ('create_subscription', 'destroy_subscription'):
+        def recorded(*args, _method=getattr(inputs, method), **kwargs):
+            changed_in.append(threading.current_thread().name)
+            return _method(*args, **kwargs)
+        setattr(inputs, method, recorded)
+    many = ['r%d' % i for i in range(300)]
+    for _ in range(3):
+        assert node.set_parameters(robot_names=many)[0].successful
+        assert node.set_parameters(robot_names=names)[0].successful
+    spin = 'spin ' + inputs.get_fully_qualified_name()
+    assert ros_client.spin_until(lambda: len(node.node._odometry_subscriptions) == 2
+                                 and len(changed_in) >= 2 * 298, 20), len(changed_in)
+    assert set(changed_in) == {spin}, set(changed_in)
+    publishers = [ros_client.node.create_publisher(odometry, node.name(n + '/odom'), 10)
+                  for n in names]
+
+    def complete():
+        for i, publisher in enumerate(publishers):
+            msg = odometry()
+            msg.header.frame_id = 'map'
+            msg.pose.pose.position.x = float(i)
+            msg.pose.pose.orientation.w = 1.0
+            publisher.publish(msg)
+        state = node.node.snapshot().state
+        return state is not None and len(state.positions) == 2
+
+    assert ros_client.spin_until(complete, 10), 'odometry never assembled'
+    assert node.threads.failure is None, node.threads.failure
 
 
 def test_planning_does_not_block_the_subscriptions(planner, ros_client):

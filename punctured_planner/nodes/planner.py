@@ -45,7 +45,6 @@ and stop (Ctrl-C and SIGTERM alike, threads joined before anything is destroyed)
 """
 
 from collections import deque
-from collections.abc import Iterable
 from dataclasses import dataclass
 import functools
 import gc
@@ -135,7 +134,13 @@ class PlannerNode(Node):
         self.inputs.create_subscription(PoseArray, 'robot_states', self._on_robot_states,
                                         STATE)
         self._odometry_subscriptions: dict[str, Subscription] = {}
-        self._update_odometry_subscriptions(self._settings.robot_names)
+        self._update_odometry_subscriptions()
+        # A robot_names change re-subscribes in the inputs' own thread: destroying a
+        # subscription from the parameters' thread while that thread's executor built its
+        # wait set raised InvalidHandle there and stopped the node (exit 1; 1,000 names
+        # set back to 4, 2 of 2 times).
+        self._robot_names_changed = self.inputs.create_guard_condition(
+            self._update_odometry_subscriptions)
         self._latched_publishers: dict[str, Publisher] = {}  # relative topic -> publisher
         self._latched_names: list[str] = []
         for topic, msg_type in (('domain_index', UInt32), ('plan_markers', MarkerArray),
@@ -186,7 +191,7 @@ class PlannerNode(Node):
                 self._odometry = {name: value for name, value in self._odometry.items()
                                   if name in settings.robot_names}
         if 'robot_names' in changed:
-            self._update_odometry_subscriptions(settings.robot_names)
+            self._robot_names_changed.trigger()
 
     def _check_obstacles_fit(self, settings: PlannerSettings, changed: set[str]) -> None:
         """On-set and at start-up: refuse settings the obstacles cannot be planned in."""
@@ -200,7 +205,10 @@ class PlannerNode(Node):
 
     # ------------------------------------------------------------ subscriptions
 
-    def _update_odometry_subscriptions(self, names: Iterable[str]) -> None:
+    def _update_odometry_subscriptions(self) -> None:
+        """Subscribe to the odometry of every robot of robot_names, and of no other."""
+        with self._lock:
+            names = self._settings.robot_names
         for name in list(self._odometry_subscriptions):
             if name not in names:
                 self.inputs.destroy_subscription(self._odometry_subscriptions.pop(name))
