@@ -167,14 +167,18 @@ def core_plan(configurations=CONFIGURATIONS, obstacles=OBSTACLES, dimension=2, *
     return plan(workspace, np.asarray(configurations, dtype=float)[..., :dimension])
 
 
-def faulty_plan(fault):
-    """Return the Plan message of a request with one fault (its id 3; 'none': no fault)."""
+def faulty_plan(fault, **fields):
+    """
+    Return the Plan message of a request with one fault (its id 3; 'none': no fault).
+
+    fields are the request's (samples_per_leg for a large plan).
+    """
     from punctured_planner.cli import offline_plan
     from punctured_planner.ros import conversions
     from punctured_planner.ros.settings import PLANNER
     settings = PLANNER.settings({'obstacles': [-2.0, 0.5, 0.0, 0.0, -0.5, 0.0,
                                                2.5, 0.0, 0.0]})
-    outcome = offline_plan(make_request(max_speed=0.5), settings, now_ns=10 ** 18)
+    outcome = offline_plan(make_request(max_speed=0.5, **fields), settings, now_ns=10 ** 18)
     outcome.plan_id = 3
     message = conversions.plan_message(outcome, settings)
     if fault == 'paths':

@@ -544,6 +544,33 @@ def test_plans_published_back_to_back_are_all_kept(ros_client, lone_executor):
         ros_client.node.destroy_publisher(publisher)
 
 
+def test_a_large_plan_is_taken_apart_from_goals_and_control(ros_client, lone_executor):
+    """
+    A goal is accepted while a plan of 4 x 43,000 poses is still taken and converted (3 s).
+
+    plan_executor took plans in the thread of its action and its control loop: such a plan,
+    not even executed, held them 8.7 s, and the robots of a running goal got no command.
+    """
+    from planner_helpers import faulty_plan
+    from punctured_planner.ros.qos import LATCHED
+    from punctured_planner_interfaces.action import ExecutePlan
+    from punctured_planner_interfaces.msg import Plan
+    executor, action = lone_executor
+    publisher = ros_client.node.create_publisher(Plan, executor.name('plan'), LATCHED)
+    try:
+        message = faulty_plan('none', samples_per_leg=300)
+        message.plan_id = 5
+        publisher.publish(message)
+        ros_client.spin_until(lambda: False, 1.0)  # on its way, then taken
+        sent = action.send_goal_async(ExecutePlan.Goal(plan_id=5))
+        assert ros_client.spin_until(sent.done, 30) and sent.result().accepted
+        assert 'plan 5: 4 robots' not in executor.log(), executor.log()
+        assert ros_client.spin_until(lambda: 'plan 5: 4 robots' in executor.log(), 60), \
+            executor.log()
+    finally:
+        ros_client.node.destroy_publisher(publisher)
+
+
 def test_a_goal_starts_only_with_its_robots_at_rest(ros_client, lone_executor):
     """
     Robots at the plan's start whose odometry reports 0.3 m/s: the goal waits, then starts.

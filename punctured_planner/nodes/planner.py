@@ -76,6 +76,7 @@ from ..ros.planning import refuse_stopping
 from ..ros.qos import LATCHED
 from ..ros.qos import SERVER_QOS
 from ..ros.qos import STATE
+from ..ros.runtime import companion
 from ..ros.runtime import NodeGroup
 from ..ros.runtime import run_nodes
 from ..ros.runtime import Stop
@@ -127,9 +128,9 @@ class PlannerNode(Node):
 
         # The service's, the subscriptions' and the publishers' own nodes: each spun
         # apart, and apart from the parameter services (module docstring).
-        self.server = self._companion('server')
-        self.inputs = self._companion('inputs')
-        self.outputs = self._companion('outputs')
+        self.server = companion(self, 'server')
+        self.inputs = companion(self, 'inputs')
+        self.outputs = companion(self, 'outputs')
         self.inputs.create_subscription(PoseArray, 'obstacles', self._on_obstacles, LATCHED)
         self.inputs.create_subscription(PoseArray, 'robot_states', self._on_robot_states,
                                         STATE)
@@ -170,14 +171,6 @@ class PlannerNode(Node):
             % (self.resolve_service_name('plan_sequence'), s.frame_id, s.dimension,
                s.core_variant, s.robot_radius, self._obstacles.describe(),
                ', '.join(s.robot_names) or (str(s.robot_count) if s.robot_count else 'any')))
-
-    def _companion(self, role: str) -> Node:
-        """Return the companion node ``<name>_<role>``: same namespace and context."""
-        # A local __node remap outranks a global one (-r __node:=NAME, launch name=).
-        name = '%s_%s' % (self.get_name(), role)
-        return Node(name, context=self.context, namespace=self.get_namespace(),
-                    cli_args=['--ros-args', '-r', '__node:=' + name],
-                    start_parameter_services=False)
 
     # ------------------------------------------------------------ parameters
 

@@ -233,6 +233,20 @@ def _ignore(number, frame):
     """Signal handler: nothing to do, the wake-up fd has woken StopSignals.wait."""
 
 
+def companion(node: Node, role: str) -> Node:
+    """
+    Return the companion node ``<name>_<role>`` of node: same namespace and context.
+
+    Spun in a thread of its own (NodeGroup), so what its callbacks take (a large
+    message, a plan) never holds the node's own.
+    """
+    # A local __node remap outranks a global one (-r __node:=NAME, launch name=).
+    name = '%s_%s' % (node.get_name(), role)
+    return Node(name, context=node.context, namespace=node.get_namespace(),
+                cli_args=['--ros-args', '-r', '__node:=' + name],
+                start_parameter_services=False)
+
+
 @dataclass
 class NodeGroup:
     """
