@@ -180,7 +180,8 @@ ODOM_TIMEOUT = 0.5
 
 def closed_loop(reference, bodies, gap, shared_clock, slow=0, late=1, limit=400.0,
                 acceleration=0.0, adaptation=ExecutionSettings.feedforward_adaptation,
-                speed=0.5, latency=0.2, seed=3, max_speeds=(), muted=None):
+                speed=0.5, latency=0.2, seed=3, max_speeds=(), max_accelerations=(),
+                muted=None):
     """
     Run Execution at 20 Hz against a Fleet at 40 Hz; return (fleet, execution, seconds).
 
@@ -197,7 +198,8 @@ def closed_loop(reference, bodies, gap, shared_clock, slow=0, late=1, limit=400.
     execution = Execution(reference, tracking_tolerance(gap, np.inf),
                           ExecutionSettings(speed_limit=speed, shared_clock=shared_clock,
                                             feedforward_adaptation=adaptation,
-                                            max_speeds=max_speeds),
+                                            max_speeds=max_speeds,
+                                            max_accelerations=max_accelerations),
                           bodies)
     now, heard, heard_at = 0.0, fleet.positions.copy(), np.zeros(k)
     while now < limit:
@@ -238,6 +240,28 @@ def test_accelerations_limited_fleet_follows_a_plan_stamped_for_it():
     assert execution.max_errors.max() <= tracking_tolerance(gap, np.inf)
     assert np.linalg.norm(fleet.positions - reference.positions[-1], axis=1).max() <= 0.02
     assert reference.duration < seconds <= 1.5 * 2 * reference.duration
+
+
+def test_robots_own_acceleration_limit_times_a_plan_stamped_without_one():
+    """
+    1 m/s^2 robots given max_accelerations on stamps made without a limit: 0.46 delta.
+
+    Their limit was taken only for a plan stamped under one of its own, so on this one the
+    reference's velocity jumped at every corner: 0.95 delta here, past the clock's hold
+    threshold (0.6 delta), and 3x the tolerance over DDS.
+    """
+    reference, bodies, gap = certified_fleet()
+    assert reference.profile is None
+    fleet, execution, seconds = closed_loop(reference, bodies, gap, shared_clock=True,
+                                            acceleration=1.0, max_accelerations=(1.0,))
+    timed = execution.reference
+    assert np.all(timed.profile.max_acceleration == ACCELERATION_SHARE * 1.0)
+    assert np.allclose(timed.profile.max_speed, 0.5)
+    assert np.array_equal(timed.positions, reference.positions)
+    assert fleet.min_gap >= 0
+    assert execution.max_errors.max() <= (ExecutionSettings.hold_fraction
+                                          * tracking_tolerance(gap, np.inf))
+    assert np.linalg.norm(fleet.positions - reference.positions[-1], axis=1).max() <= 0.02
 
 
 def test_stale_odometry_brakes_the_clock_within_the_robots_acceleration_limit():
@@ -697,7 +721,11 @@ def test_plan_message_carries_the_acceleration_limit_to_the_executor():
 
 
 def test_retimed_reference_keeps_the_poses_and_each_robots_own_speed():
-    """Same poses in the same order; robot i never faster than its own limits, nor the plan."""
+    """
+    Same poses in the same order; robot i never faster than its own limits, nor the plan.
+
+    A plan stamped without an acceleration limit is timed under the robots' own.
+    """
     for acceleration in (0.0, 1.0):
         reference, _, gap = certified_fleet(acceleration=acceleration)
         k = reference.robot_count
@@ -709,12 +737,11 @@ def test_retimed_reference_keeps_the_poses_and_each_robots_own_speed():
         times = np.linspace(0.0, retimed.duration, 3001)
         velocity = np.array([np.linalg.norm(retimed.velocity(s), axis=1) for s in times])
         assert np.all(velocity <= speeds + 1e-6)
-        if acceleration:
-            change = np.array([np.linalg.norm(retimed.acceleration(s), axis=1)
-                               for s in times])
-            assert np.all(change <= accelerations + 1e-6)
-        # limits above the plan's change nothing: its own profile's stamps
-        same = reference.retimed(np.full(k, 9.0), np.full(k, 9.0),
+        change = np.array([np.linalg.norm(retimed.acceleration(s), axis=1) for s in times])
+        assert np.all(change <= accelerations + 1e-6)
+        # limits above the plan's change nothing: its own profile's stamps (no acceleration
+        # limit on a plan without one)
+        same = reference.retimed(np.full(k, 9.0), np.full(k, 9.0 if acceleration else np.inf),
                                  tracking_tolerance(gap, np.inf))
         own = reference.profile.stamps() if acceleration else reference.seconds
         assert np.allclose(same.seconds, own, atol=1e-9)

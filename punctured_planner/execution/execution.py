@@ -216,8 +216,9 @@ class Execution:
 
         The clock runs on the plan retimed (Reference.retimed) for robots slower
         than the plan (settings.max_speeds), and, for a plan timed under an
-        acceleration limit, for ACCELERATION_SHARE of each robot's acceleration
-        (max_accelerations, else the plan's): its plan time is then that timing's.
+        acceleration limit or robots given one (max_accelerations), for
+        ACCELERATION_SHARE of each robot's acceleration (its own, at most the
+        plan's): its plan time is then that timing's.
         """
         self.tolerance = float(tolerance)
         k = reference.robot_count
@@ -231,9 +232,12 @@ class Execution:
         self.differential = settings.differential(k)
         # a timed plan stops where a differential robot switches its driving direction
         # (it passes through rest there anyway, doc/design.md section 13)
+        # timed under an acceleration limit: the plan's, or the robots' own on a plan
+        # stamped without one (which they could not follow at its corners)
+        timed = profile is not None or accelerations is not None
         stops = (unicycle.Corners(reference.seconds, reference.positions).turns(
-            self.differential) if profile is not None else np.zeros(0, dtype=bool))
-        if speeds is not None or profile is not None:
+            self.differential) if timed else np.zeros(0, dtype=bool))
+        if speeds is not None or timed:
             reference = reference.retimed(
                 np.full(k, np.inf) if speeds is None else speeds,
                 self.accelerations, self.tolerance, stops if stops.any() else None)
@@ -247,7 +251,7 @@ class Execution:
                                   settings.hold_fraction)
         self.steering = unicycle.steering(self.lead)
         self.corners = unicycle.Corners(reference.seconds, reference.positions,
-                                        reference.at_rest() if profile is not None else None)
+                                        reference.at_rest() if timed else None)
         self.final_yaws = unicycle.yaws(reference.orientation(reference.duration))
         self.turning = np.zeros(reference.robot_count, dtype=bool)
         # robots driving backward: their lead point is e behind, their 'heading' theta + pi

@@ -74,23 +74,35 @@ class Reference:
         Return the same motion timed so that robot i needs at most its own limits (k,).
 
         No robot faster than the plan: each limit is taken at most the plan's.
-        A plan stamped without an acceleration limit keeps linear intervals,
-        each at least as long as its slowest robot's move at max_speeds[i];
-        one stamped under a limit gets :func:`fleet_profile`'s stamps, at rest
-        at the poses where stops (M,) is true (doc/design.md section 8; a plan
-        without the limit has no rest inside). Orientations stay with their poses.
+        A plan stamped under an acceleration limit, or any plan when every
+        max_accelerations is finite, gets :func:`fleet_profile`'s stamps (a plan
+        stamped without a limit at its own top speed), at rest at the poses where
+        stops (M,) is true (doc/design.md section 8); otherwise the intervals stay
+        linear, each at least as long as its slowest robot's move at max_speeds[i].
+        Orientations stay with their poses.
         """
         speeds = np.asarray(max_speeds, dtype=float)
-        if self.profile is None:
+        accelerations = np.asarray(max_accelerations, dtype=float)
+        if self.profile is not None:
+            top_speed, top_acceleration = self.profile.max_speed, self.profile.max_acceleration
+        else:
+            top_speed, top_acceleration = self.top_speed(), np.inf
+        if self.profile is None and not (np.isfinite(accelerations).all() and top_speed > 0):
             moves = np.linalg.norm(np.diff(self.positions, axis=0), axis=2)
             slowest = (moves / speeds).max(axis=1, initial=0.0)
             durations = np.maximum(np.diff(self.seconds), slowest)
             return Reference(np.concatenate([[0.0], np.cumsum(durations)]), self.positions,
                              self.orientations)
-        profile = fleet_profile(self.positions, np.minimum(speeds, self.profile.max_speed),
-                                np.minimum(max_accelerations, self.profile.max_acceleration),
-                                tolerance, stops)
+        profile = fleet_profile(self.positions, np.minimum(speeds, top_speed),
+                                np.minimum(accelerations, top_acceleration), tolerance, stops)
         return Reference(profile.stamps(), self.positions, self.orientations, profile)
+
+    def top_speed(self) -> float:
+        """Return the fastest any robot moves over an interval (m/s): a linear plan's limit."""
+        moves = np.linalg.norm(np.diff(self.positions, axis=0), axis=2).max(axis=1, initial=0.0)
+        durations = np.diff(self.seconds)
+        timed = durations > 0
+        return float((moves[timed] / durations[timed]).max(initial=0.0))
 
     def at_rest(self) -> np.ndarray:
         """Return the (M,) poses at which the reference stands still (its profile's w = 0)."""

@@ -307,8 +307,8 @@ class ExecutorSettings:
     max_accelerations: tuple = Spec(
         'max_accelerations', 'double_array', [],
         "Each robot's own acceleration limit (m/s^2), one value for all or one per robot; "
-        "empty: the plan's max_acceleration. A plan stamped under an acceleration limit is "
-        "retimed for 0.6 of it (the rest is the feedback's), like max_speeds.",
+        "empty: the plan's max_acceleration. The plan is retimed for 0.6 of it (the rest is "
+        "the feedback's), like max_speeds: one stamped without an acceleration limit too.",
         check=within(1e-6, 1e3),
         prose='empty, one, or one per robot, in [1e-06, 1000]').field()
 
