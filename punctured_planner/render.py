@@ -19,18 +19,20 @@ import sys
 from .cli import positive_float
 from .core import Plan
 from .viz import domain_picture, example_plan, render_animation, render_png
-from .viz.animation import MAX_FPS, MAX_SECONDS
+from .viz.animation import MAX_FPS, MAX_SECONDS, MIN_FPS
 
 # Resolutions the pictures are drawn at: far below, an empty image; far above, no memory.
 MIN_DPI, MAX_DPI = 10, 1000
 
 
-def _at_most(high):
-    """Return an argparse type: a positive finite float at most high."""
+def _at_most(high, low=0.0):
+    """Return an argparse type: a positive finite float at most high (and at least low)."""
     def value_of(text):
         value = positive_float(text)
         if value > high:
             raise argparse.ArgumentTypeError(f'{text!r} is more than {high:g}')
+        if value < low:
+            raise argparse.ArgumentTypeError(f'{text!r} is less than {low:g}')
         return value
     return value_of
 
@@ -61,8 +63,8 @@ def add_render_arguments(parser: argparse.ArgumentParser) -> argparse._ArgumentG
                        help='draw the plan (paths, lanes, waypoints, domain, clearance)')
     group.add_argument('--gif', metavar='OUT.gif', type=_file_of('.gif', 'the animation'),
                        help='animate the synchronous motion of all robots')
-    group.add_argument('--gif-fps', type=_at_most(MAX_FPS), default=20.0,
-                       help='frames per second of the animation, at most 50 '
+    group.add_argument('--gif-fps', type=_at_most(MAX_FPS, MIN_FPS), default=20.0,
+                       help='frames per second of the animation, from 1/60 to 50 '
                        '(default: %(default)s)')
     group.add_argument('--gif-seconds', type=_at_most(MAX_SECONDS), default=8.0,
                        help='length of the animation in seconds, at most 60 '

@@ -263,6 +263,7 @@ def test_command_line_and_wiring(tmp_path, capsys):
     for options, words in ((['--png', 'out.jpg'], 'written as a .png file'),
                            (['--gif-fps', 'inf'], 'not a positive finite number'),
                            (['--gif-fps', '100'], 'more than 50'),
+                           (['--gif-fps', '0.001'], 'less than 0.0166667'),
                            (['--gif-seconds', '61'], 'more than 60'),
                            (['--dpi', '1e-3'], 'is not in [10, 1000]'),
                            (['--gif-dpi', '1e5'], 'is not in [10, 1000]')):

@@ -28,6 +28,9 @@ from ..core.timing import leg_at
 # an animation has at most MAX_FPS x MAX_SECONDS of them.
 MAX_FPS = 50.0
 MAX_SECONDS = 60.0
+# One frame at most as long as the longest animation: a GIF frame's delay is 16 bits of
+# centiseconds, and 0.001 fps overflowed it inside Pillow (a traceback, no picture).
+MIN_FPS = 1.0 / MAX_SECONDS
 
 
 def frame_parameters(plan: Plan, frame_count: int, max_speed: float = 1.0,
@@ -122,10 +125,11 @@ def render_animation(plan: Plan, path: str | os.PathLike[str], fps: float = 20,
     """
     if os.path.splitext(str(path))[1].lower() != '.gif':
         raise ValueError(f'render_animation writes GIF files; {path!r} does not end in .gif')
-    if not (0 < fps <= MAX_FPS and 0 < seconds <= MAX_SECONDS):
-        raise ValueError(f'fps must be in (0, {MAX_FPS:g}] (a GIF frame lasts at least '
-                         f'{1000 / MAX_FPS:g} ms) and seconds in (0, {MAX_SECONDS:g}]; got fps '
-                         f'{fps:g}, seconds {seconds:g}')
+    if not (MIN_FPS <= fps <= MAX_FPS and 0 < seconds <= MAX_SECONDS):
+        raise ValueError(f'fps must be in [{MIN_FPS:g}, {MAX_FPS:g}] (a GIF frame lasts at '
+                         f'least {1000 / MAX_FPS:g} ms and at most {MAX_SECONDS:g} s) and '
+                         f'seconds in (0, {MAX_SECONDS:g}]; got fps {fps:g}, seconds '
+                         f'{seconds:g}')
     count = int(round(100.0 * seconds / frame_centiseconds(fps)))
     tau, stamps = frame_parameters(plan, count, max_speed,
                                    max_acceleration)
