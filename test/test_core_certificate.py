@@ -130,3 +130,22 @@ def test_a_gap_below_the_required_clearance_is_named_before_the_resolution():
     words = str(error.value)
     assert 'surface to surface (gap), < required 2' in words, words
     assert 'resolution' not in words, words
+
+
+def test_many_disc_robots_are_certified_as_every_pair_gives(monkeypatch):
+    """70 disc robots (the pruned path): the surface gap of evaluating every pair."""
+    rng = np.random.default_rng(1)
+    positions = rng.uniform(-10, 10, (4, 70, 2))
+    radii = np.full(70, 0.2)
+    times = np.linspace(0.0, 1.0, 4)
+    pruned = certify(times, positions, np.zeros((0, 2)), radii)
+    monkeypatch.setattr(certificate, '_DIRECT_ROBOTS', 10 ** 6)
+    direct = certify(times, positions, np.zeros((0, 2)), radii)
+    assert pruned.distance == direct.distance
+
+
+def test_a_tie_is_reported_at_its_first_leg():
+    """40 robots of a grid translating in exact steps: every leg ties; the first is named."""
+    grid = np.stack(np.meshgrid(np.arange(8.0), np.arange(5.0)), -1).reshape(40, 2)
+    positions = grid + (0.5 * np.arange(100))[:, None, None] * np.array([1.0, 0.0])
+    assert certify(np.linspace(0.0, 1.0, 100), positions, np.zeros((0, 2))).leg == 0

@@ -502,3 +502,35 @@ def test_passing_orders_end_in_the_next_order_each_slide_within_the_lane_limit(o
                        for later in rounds[at + 1:])
     assert (len(steps) == 1) == (shared_lanes(first, second).max() < limit)
     assert len(passing_orders(first, second, None)) == 1
+
+
+def test_point_robots_keep_half_the_spacing_from_point_pillars():
+    """Robots and pillars of radius 0 (min_spacing 1): a pillar's reach is 0.5."""
+    from punctured_planner.core.discs import PillarClearance
+    assert PillarClearance.from_radii(0.0, np.array([0.0]), 1.0).reach[0] == 0.5
+
+
+def test_the_fleet_stages_a_slot_gap_above_every_pillar():
+    """With a pitch above 2R + nu, the staging height clears a pillar by the slots' gap."""
+    from punctured_planner.core.discs import PillarClearance
+    sizes = PillarClearance.from_radii(0.1, np.array([0.1]), 1.0)
+    assert sizes.pitch == 1.0
+    assert sizes.clear[0] >= 0.1 + sizes.pitch - 0.1
+
+
+def test_a_robot_on_a_pillars_projection_is_pushed_to_its_right():
+    """Ties go right (the paper numbers robots after obstacles), so a push is >= 0."""
+    workspace = Workspace(np.array([[0.0, 2.0]]), variant='discs', robot_radius=0.2,
+                          obstacle_radius=0.15)
+    layout = workspace.disc_layout
+    robot = np.array([[0.0, 0.0]])
+    p, h = layout.frame.project(robot), layout.frame.offset(robot)
+    assert p[0] == layout.pillar_projections[0]
+    motion = rise(p, h, layout, layout.reaches(robot))
+    assert motion.shift.min() == 0.0 and motion.shift.max() > 0.0
+
+
+def test_projection_ties_rank_by_index():
+    """Slots are ranks by projection, ties by robot index."""
+    from punctured_planner.core.discs import staging_ranks
+    assert staging_ranks(np.array([1.0, 0.0, 1.0])).tolist() == [1, 0, 2]

@@ -254,3 +254,10 @@ def test_a_plan_inside_its_walls_is_returned_and_one_outside_refused():
         plan(Workspace(low_pillar, bounds=tight, **options), [starts, goals - [0.0, 0.3]])
     assert caught.value.code == ErrorCode.OUTSIDE_WORKSPACE
     assert 'on leg' in str(caught.value)  # refused after planning, not as input
+
+
+def test_the_configurations_knots_have_no_room_to_move():
+    """A knot at a configuration gets caps 0 whatever its neighbours' slack: it is held."""
+    from punctured_planner.core.refine import _knot_caps, KNOTS
+    caps = _knot_caps(np.ones((2 * KNOTS, 3)))
+    assert np.all(caps[::KNOTS] == 0.0) and np.all(caps[1:KNOTS] == 1.0)

@@ -236,3 +236,29 @@ def test_timed_reference_is_exact_at_stamps_and_followable_between():
     # between grid points a velocity changes by a dt, or by at most a corner's jump
     assert jumps.max() <= corner_jump(0.8, p.tracking_tolerance) + 0.8 * np.diff(times)[0] + 1e-9
     assert np.array_equal(reference.velocity(reference.duration), np.zeros((4, 3)))
+
+
+def test_a_legs_state_is_never_beyond_the_leg():
+    """
+    At and just before a leg's end, and past it, sigma is never beyond the leg's length.
+
+    A leg that ends cruising came an ulp past its end just before it (the braking phase
+    was clamped, the cruising one not): a reference an ulp beyond its pose.
+    """
+    rng = np.random.default_rng(0)
+    for _ in range(300):
+        positions = np.cumsum(rng.normal(size=(6, 2, 2)), axis=0)
+        profile = speed_profile(positions, rng.uniform(0.1, 2), rng.uniform(0.1, 2),
+                                rng.uniform(0.0, 1.0))
+        durations = profile.durations()
+        for leg, duration in enumerate(durations):
+            for t in (np.nextafter(duration, 0.0), duration, 1e9):
+                assert profile.state_at(leg, t).distance <= profile.lengths[leg]
+
+
+def test_a_robot_moving_half_as_far_may_be_half_as_fast():
+    """fleet_profile takes each robot's own move: one at half the speed over half the way."""
+    positions = np.array([[[0.0, 0.0], [0.0, 5.0]], [[20.0, 0.0], [10.0, 5.0]]])
+    fleet = fleet_profile(positions, np.array([1.0, 0.5]), np.array([1.0, 1.0]), 0.5)
+    alone = speed_profile(positions, 1.0, 1.0, corner_jump(1.0, 0.5))
+    assert fleet.stamps()[-1] == pytest.approx(alone.stamps()[-1])

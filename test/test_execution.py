@@ -902,3 +902,99 @@ def test_a_goal_starts_only_at_the_plans_start_and_a_hold_names_who_it_waits_for
     assert far.robots.tolist() == [2] and far.distances[0] == pytest.approx(2 * delta)
     assert waited_for(np.array([0.1, 0.5, 0.7]), 0.5).tolist() == [1, 2]
     assert waited_for(np.array([0.1, 0.3, 0.2]), 0.5).tolist() == [1]
+
+
+def _two_robots():
+    """Return a linear two-robot Reference of 10 s: one along x, one along y."""
+    positions = np.array([[[0.0, 0.0, 0.0], [5.0, 0.0, 0.0]],
+                          [[10.0, 0.0, 0.0], [5.0, 10.0, 0.0]]])
+    return Reference(np.array([0.0, 10.0]), positions, np.tile(IDENTITY, (2, 2, 1)))
+
+
+def _timed_pair():
+    """Return a two-robot Reference stamped under 1 m/s and 1 m/s^2, tolerance 0.5 m."""
+    positions = np.array([[[0.0, 0.0, 0.0], [0.0, 2.0, 0.0]],
+                          [[10.0, 0.0, 0.0], [10.0, 2.0, 0.0]]])
+    return Reference.timed(np.array([0.0, 11.0]), positions, np.tile(IDENTITY, (2, 2, 1)),
+                           1.0, 1.0, 0.5)
+
+
+def test_a_stale_robots_unknown_position_is_no_tracking_error():
+    """A stale robot 100 m off counts no error: its position says nothing (it is held)."""
+    reference = _two_robots()
+    execution = Execution(reference, 0.5, ExecutionSettings(speed_limit=2.0))
+    far = reference.position(0.0).copy()
+    far[1] += [100.0, 0.0, 0.0]
+    step = execution.step(0.1, far, [False, True])
+    assert step.errors[1] == 0.0
+    assert execution.beyond_tolerance().size == 0
+
+
+def test_the_plan_time_stops_at_the_plans_end_and_a_stall_moves_it_one_step():
+    """A control step of 3 s moves the clock by MAX_STEP at most; it never passes the end."""
+    from punctured_planner.execution.execution import MAX_STEP
+    reference = _two_robots()
+    execution = Execution(reference, 0.5, ExecutionSettings(speed_limit=2.0))
+    step = execution.step(3.0, reference.position(0.0), [False, False])
+    assert 0.0 < step.plan_time <= MAX_STEP
+    for _ in range(80):
+        step = execution.step(0.2, reference.position(execution.plan_time), [False, False])
+    assert step.plan_time == reference.duration
+
+
+def test_a_stale_robots_feedforward_keeps_its_speed_limit():
+    """The stale robot, driven on its feed-forward alone, is never commanded past its limit."""
+    execution = Execution(_timed_pair(), 0.5, ExecutionSettings(speed_limit=0.5))
+    own = execution.reference
+    for _ in range(60):
+        step = execution.step(0.05, own.position(execution.plan_time), [False, False])
+    assert step.rate > 0.5
+    step = execution.step(0.05, own.position(execution.plan_time), [False, True])
+    assert step.rate > 0.0
+    assert np.linalg.norm(step.velocities[1]) <= 0.5 + 1e-12
+
+
+def test_the_clock_rises_from_rest_within_the_acceleration_limit():
+    """At rest the reference's speed is 0: the first step's rate is still bounded."""
+    from punctured_planner.execution.execution import ADAPT_SPEED
+    execution = Execution(_timed_pair(), 0.5, ExecutionSettings(speed_limit=2.0))
+    step = execution.step(0.05, execution.reference.position(0.0), [False, False])
+    assert 0.0 < step.rate <= float(execution.accelerations.min()) * 0.05 / ADAPT_SPEED
+
+
+def test_a_lag_below_the_slow_threshold_leaves_the_feedforward_gains_alone():
+    """Half the slow threshold behind a moving reference, 40 steps: every gain stays 1."""
+    reference = _two_robots()
+    settings = ExecutionSettings(speed_limit=5.0)
+    execution = Execution(reference, 0.5, settings)
+    lag = 0.5 * settings.slow_fraction * 0.5
+    for _ in range(40):
+        velocity = reference.velocity(execution.plan_time)
+        behind = reference.position(execution.plan_time) - lag * velocity / np.linalg.norm(
+            velocity, axis=1, keepdims=True)
+        execution.step(0.05, behind, [False, False])
+    assert execution.plan_time > 1.0
+    assert np.all(execution.feedforward_gains == 1.0)
+
+
+def test_a_robot_whose_speed_is_nan_is_not_at_rest():
+    """A goal starts only with every robot at rest: NaN odometry speed is not rest."""
+    from punctured_planner.execution.hold import still_moving
+    assert still_moving(np.array([np.nan, 0.0, 0.1])).tolist() == [0, 2]
+
+
+def test_stamps_longer_than_the_profile_stretch_velocity_and_acceleration_with_it():
+    """A timed plan on stamps twice its own: velocity and acceleration are the derivatives."""
+    positions = np.array([[[0.0, 0.0, 0.0]], [[4.0, 0.0, 0.0]], [[4.0, 3.0, 0.0]]])
+    stamps = Reference.timed(np.array([0.0, 1.0, 2.0]), positions,
+                             np.tile(IDENTITY, (3, 1, 1)), 1.0, 1.0, 0.5).profile.stamps()
+    stretched = Reference.timed(2.0 * stamps, positions, np.tile(IDENTITY, (3, 1, 1)),
+                                1.0, 1.0, 0.5)
+    h = 1e-5
+    for s in np.linspace(0.05, 2.0 * stamps[-1] - 0.05, 37):
+        if np.any(np.abs(s - 2.0 * stamps) < 1e-3):
+            continue
+        velocity = (stretched.position(s + h) - stretched.position(s - h)) / (2 * h)
+        change = (stretched.velocity(s + h) - stretched.velocity(s - h)) / (2 * h)
+        assert np.allclose(stretched.velocity(s), velocity, atol=1e-6)
+        assert np.allclose(stretched.acceleration(s), change, atol=1e-4)

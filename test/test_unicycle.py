@@ -369,3 +369,14 @@ def test_a_timed_plan_stops_where_a_differential_robot_switches_direction():
     plain = Reference.timed(np.array([0.0, 3.0, 6.0]), straight, orientations, 1.0, 1.0, 0.25)
     assert Execution(plain, 0.25, ExecutionSettings(drive=drive)).reference.at_rest(
     ).tolist() == [True, False, True]
+
+
+def test_the_lead_fits_half_the_room_between_the_thresholds():
+    """The lead e is at most (hold - slow) delta / 2, even below LEAD_FRACTION delta."""
+    assert unicycle.lead(0.1, 0.5, 0.6) <= 0.5 * (0.6 - 0.5) * 0.1
+
+
+def test_the_creep_rate_is_the_same_on_either_side():
+    """A reference to the robot's right slows the clock as one to its left does."""
+    rates = unicycle.creep_rate(np.array([0.5, -0.5]), np.array([1.0, 1.0]), 0.1, 1.0)
+    assert rates[0] == rates[1] < 1.0

@@ -175,14 +175,18 @@ class SpeedProfile:
         a, start = float(self._accelerations[leg]), float(self.speeds[leg])
         peak, speeding, cruising, braking = (float(phase[leg]) for phase in self._phases)
         t = min(max(seconds, 0.0), speeding + cruising + braking)
-        if t < speeding:
-            return LegState(start * t + 0.5 * a * t * t, start + a * t, a)
         reach = start * speeding + 0.5 * a * speeding ** 2
-        if t < speeding + cruising:
-            return LegState(reach + peak * (t - speeding), peak, 0.0)
         late = t - speeding - cruising
-        distance = reach + peak * cruising + peak * late - 0.5 * a * late * late
-        return LegState(min(distance, float(self.lengths[leg])), peak - a * late, -a)
+        if t < speeding:
+            distance, speed, acceleration = start * t + 0.5 * a * t * t, start + a * t, a
+        elif t < speeding + cruising:
+            distance, speed, acceleration = reach + peak * (t - speeding), peak, 0.0
+        else:
+            distance = reach + peak * cruising + peak * late - 0.5 * a * late * late
+            speed, acceleration = peak - a * late, -a
+        # Rounded, a phase's end can come an ulp past the leg's (a leg that ends cruising,
+        # just before its end): never beyond the pose it ends at.
+        return LegState(min(distance, float(self.lengths[leg])), speed, acceleration)
 
 
 def speed_profile(positions: np.ndarray, max_speed: float, max_acceleration: float,
