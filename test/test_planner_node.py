@@ -706,7 +706,8 @@ def test_odometry_assembles_the_current_state(planner, ros_client):
     response = ros_client.call(client, make_request(CONFIGURATIONS[1:],
                                                     use_current_state=True))
     assert response.error_code == plan_sequence.Response.FRAME_MISMATCH
-    assert 'current robot state' in response.error_msg
+    assert "current robot state from odometry of r0, r1, r2, r3) is in frame 'odom' (the " \
+        'odometry of r2)' in response.error_msg, response.error_msg
 
 
 def test_robot_names_change_the_subscriptions_in_the_inputs_thread(planner, ros_client):

@@ -222,6 +222,40 @@ def test_a_stale_robot_state_is_refused_with_its_age_and_source():
     assert unchecked.ok
 
 
+def test_a_state_from_odometry_names_the_robots_too_old_or_in_another_frame():
+    """
+    NO_ROBOT_STATE and FRAME_MISMATCH from odometry name the robot at fault, not the fleet.
+
+    Both said 'the robot state from odometry of robot_0, robot_1, robot_2, robot_3': with
+    50 robots, no word of which one to fix.
+    """
+    from planner_helpers import CONFIGURATIONS
+    from punctured_planner.ros.snapshot import RobotOdometry
+    from punctured_planner.ros.snapshot import take_snapshot
+    now = 1700000000 * 10 ** 9
+    names = ['r0', 'r1', 'r2', 'r3']
+    settings = PLANNER.settings({'obstacles': flat(OBSTACLES), 'robot_names': names})
+    request = make_request(CONFIGURATIONS[1:], use_current_state=True)
+
+    def snapshot(ages, frames):
+        odometry = {name: RobotOdometry(np.asarray(CONFIGURATIONS[0][i], dtype=float),
+                                        np.array([0.0, 0.0, 0.0, 1.0]), frames[i], now,
+                                        now - int(ages[i] * 1e9), 0.0)
+                    for i, name in enumerate(names)}
+        return take_snapshot(settings, ObstacleSet(np.array(OBSTACLES)), None, odometry)
+
+    old = answer(request, snapshot([0.1, 3.5, 0.1, 0.9], ['map'] * 4), now)
+    assert old.response.error_code == ErrorCode.NO_ROBOT_STATE, old.response.error_msg
+    assert old.response.error_msg.endswith(
+        'more than max_state_age 0.5 s: the odometry of r1 (3.500 s old) and r3 (0.900 s '
+        'old)'), old.response.error_msg
+    elsewhere = answer(request, snapshot([0.1] * 4, ['map', 'map', 'odom', 'map']), now)
+    assert elsewhere.response.error_code == ErrorCode.FRAME_MISMATCH
+    assert ("is in frame 'odom' (the odometry of r2), the planning frame is 'map'"
+            in elsewhere.response.error_msg), elsewhere.response.error_msg
+    assert answer(request, snapshot([0.1] * 4, ['map'] * 4), now).ok
+
+
 def test_a_configuration_repeating_the_current_state_is_dropped():
     """Issue 15.2: resending the current positions first is no 30 s detour."""
     from planner_helpers import CONFIGURATIONS

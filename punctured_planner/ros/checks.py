@@ -133,13 +133,22 @@ def gather(request: Any, snapshot: Snapshot, now_ns: int) -> Gathered:
 
 
 def _check_state_age(settings: PlannerSettings, state: RobotState, now_ns: int) -> None:
-    """NO_ROBOT_STATE when the state is older than max_state_age (0: no limit)."""
+    """
+    NO_ROBOT_STATE when the state is older than max_state_age (0: no limit).
+
+    A state from odometry is as old as its oldest robot's: the robots too old are named.
+    """
     age = (int(now_ns) - state.received_ns) * 1e-9
     if settings.max_state_age > 0 and age > settings.max_state_age:
+        ages = [(name, (int(now_ns) - arrival) * 1e-9)
+                for name, arrival in zip(state.robots, state.arrivals_ns)]
+        old = ' and '.join('%s (%.3f s old)' % (name, robot_age) for name, robot_age in ages
+                           if robot_age > settings.max_state_age)
         fail(ErrorCode.NO_ROBOT_STATE, 'use_current_state is set but the robot state from %s '
-             'is %.3f s old (received at %s, stamp %s), more than max_state_age %g s'
+             'is %.3f s old (received at %s, stamp %s), more than max_state_age %g s%s'
              % (state.source, age, format_stamp(state.received_ns),
-                format_stamp(state.stamp_ns), settings.max_state_age))
+                format_stamp(state.stamp_ns), settings.max_state_age,
+                ': the odometry of ' + old if old else ''))
 
 
 def _check_limits(settings: PlannerSettings, n: int, counts: list[int], samples: int) -> None:
@@ -219,7 +228,7 @@ def check(gathered: Gathered, snapshot: Snapshot) -> Checked:
         c.header.frame_id for c in gathered.configurations]
     _check_non_finite(positions)
     check_obstacle_values(obstacles)
-    _check_frames(settings, frames)
+    _check_frames(settings, frames, state)
     check_obstacle_frame(settings, obstacles)
     _check_plane(settings, positions)
     check_obstacle_plane(settings, obstacles)
@@ -325,13 +334,23 @@ def check_obstacle_values(obstacles: ObstacleSet) -> None:
                             obstacle=bad[0], coordinate=bad[1])
 
 
-def _check_frames(settings: PlannerSettings, frames: list[str]) -> None:
-    """FRAME_MISMATCH: a configuration in a frame other than the planning frame."""
+def _check_frames(settings: PlannerSettings, frames: list[str],
+                  state: RobotState | None) -> None:
+    """
+    FRAME_MISMATCH: a configuration in a frame other than the planning frame.
+
+    A state from odometry (configuration 0) names the robots whose odometry is in another.
+    """
     for m, frame_id in enumerate(frames):
         if in_other_frame(frame_id, settings.frame_id):
-            raise PlanningError(ErrorCode.FRAME_MISMATCH, "{configuration} is in frame '%s', "
-                                "the planning frame is '%s'" % (literal(frame_id),
-                                                                literal(settings.frame_id)),
+            whose = [] if m or state is None else [
+                name for name, frame in zip(state.robots, state.frames)
+                if in_other_frame(frame, settings.frame_id)]
+            raise PlanningError(ErrorCode.FRAME_MISMATCH, "{configuration} is in frame '%s'%s, "
+                                "the planning frame is '%s'"
+                                % (literal(frame_id),
+                                   literal(' (the odometry of %s)' % ', '.join(whose))
+                                   if whose else '', literal(settings.frame_id)),
                                 configuration=m)
 
 

@@ -88,6 +88,11 @@ class RobotState:
     stamp_ns: int = 0
     source: str = 'robot_states'
     received_ns: int = 0  # node clock when it arrived (the oldest robot's, for odometry)
+    # From odometry (robot_names): whose each position is, and its frame and arrival, so a
+    # refusal names the robot at fault (empty from robot_states)
+    robots: tuple[str, ...] = ()
+    frames: tuple[str, ...] = ()
+    arrivals_ns: tuple[int, ...] = ()
 
     def describe(self) -> str:
         """Return a short text for the log: robots, source and stamp."""
@@ -192,7 +197,8 @@ def take_snapshot(settings: PlannerSettings, obstacles: ObstacleSet,
             np.stack([e.position for e in entries]),
             np.stack([e.orientation for e in entries]), frame,
             min(e.stamp_ns for e in entries), 'odometry of %s' % ', '.join(names),
-            min(e.received_ns for e in entries)))
+            min(e.received_ns for e in entries), tuple(names), tuple(frames),
+            tuple(e.received_ns for e in entries)))
     if candidates:
         return Snapshot(settings, obstacles,
                         max(candidates, key=lambda state: state.received_ns), '')
