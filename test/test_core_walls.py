@@ -632,3 +632,24 @@ def test_the_walls_room_is_a_range_between_them_or_none():
                        robot_radius=0.2, obstacle_radius=0.1, bounds=[[-3.0, 4.0]] * 3)
     assert np.count_nonzero(moment.frame.e1) == 3
     assert (moment.disc_layout.walls.low, moment.disc_layout.walls.high) == (-np.inf, np.inf)
+
+
+def test_the_refinement_brings_a_plan_that_leaves_the_walls_inside():
+    """
+    A hall fleet (bench/hall.py's kind, three robots, six pillars): refined inside the walls.
+
+    The construction's motion leaves the hall (refused, OUTSIDE_WORKSPACE); the refined
+    one is inside, keeping its margin (section 14, *Walls*: once inside, never out).
+    """
+    pillars = np.array([[0.05, 0.1], [2.88, 0.31], [2.67, 3.55], [0.03, 1.41], [3.35, 1.83],
+                        [1.11, 3.32]])
+    configurations = np.array([[[2.0, 2.75], [3.91, 3.01], [1.67, 1.16]],
+                               [[1.19, 3.87], [1.39, 1.43], [1.29, 0.22]],
+                               [[1.22, 1.95], [3.18, 1.03], [3.82, 3.47]]])
+    workspace = Workspace(pillars, variant='discs', robot_radius=0.2, obstacle_radius=0.15,
+                          bounds=np.array([[-0.55, 4.49], [-0.48, 4.45]]))
+    with pytest.raises(PlanningError) as refused:
+        plan(workspace, configurations, refine=False)
+    assert refused.value.code == ErrorCode.OUTSIDE_WORKSPACE
+    inside = plan(workspace, configurations)
+    assert inside.min_gap >= inside.margin > 0
