@@ -256,6 +256,28 @@ def test_a_state_from_odometry_names_the_robots_too_old_or_in_another_frame():
     assert answer(request, snapshot([0.1] * 4, ['map'] * 4), now).ok
 
 
+def test_robots_are_named_by_robot_names_in_every_refusal():
+    """
+    With robot_names a refusal names robot i as 'robot i (its name)', without as 'robot i'.
+
+    'robot 3 overlaps obstacle 1' left the operator of a named fleet to count.
+    """
+    from planner_helpers import CONFIGURATIONS
+    settings = {'obstacles': flat(OBSTACLES), 'robot_names': ['r0', 'r1', 'r2', 'ghost']}
+    on_pillar = [list(c) for c in CONFIGURATIONS]
+    on_pillar[1] = on_pillar[1][:3] + [OBSTACLES[1]]
+    same = [list(c) for c in CONFIGURATIONS]
+    same[2] = [same[2][0], same[2][0]] + same[2][2:]
+    for values, words in ((settings, ('robot 3 (ghost) is on obstacle 1',
+                                      'robots 0 (r0) and 1 (r1) are at the same point')),
+                          ({'obstacles': flat(OBSTACLES)},
+                           ('robot 3 is on obstacle 1', 'robots 0 and 1 are at the same'))):
+        snapshot = Snapshot(PLANNER.settings(values), ObstacleSet(np.array(OBSTACLES)))
+        for configurations, expected in zip((on_pillar, same), words):
+            outcome = answer(make_request(configurations), snapshot, 0)
+            assert expected in outcome.response.error_msg, outcome.response.error_msg
+
+
 def test_a_configuration_repeating_the_current_state_is_dropped():
     """Issue 15.2: resending the current positions first is no 30 s detour."""
     from planner_helpers import CONFIGURATIONS

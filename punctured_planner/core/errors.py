@@ -119,6 +119,14 @@ class Names:
         """Return the name of configuration m as a waypoint of the plan: C_{m+1}."""
         return f'C_{m + 1}'
 
+    def robot(self, i: int) -> str:
+        """Return the name of robot i: 'robot 3'."""
+        return f'robot {i}'
+
+    def robots(self, indices: tuple[int, ...]) -> str:
+        """Return the name of several robots: 'robots 0 and 3'."""
+        return 'robots ' + ' and '.join(str(i) for i in indices)
+
     def obstacle(self, j: int, point: Any = None) -> str:
         """Return the name of obstacle j, with its position when the error carries it."""
         return f'obstacle {j}' + ('' if point is None else f' at {point}')
@@ -147,6 +155,10 @@ class _Slots(dict):
         if slot in ('waypoint', 'next_waypoint'):
             m = int(error.configuration)  # type: ignore[arg-type]
             return names.waypoint(m if slot == 'waypoint' else m + 1)
+        if slot == 'robot':
+            return names.robot(int(error.robots[0]))
+        if slot == 'robots':
+            return names.robots(tuple(int(i) for i in error.robots))
         if slot == 'obstacle':
             return names.obstacle(int(error.obstacle), error.point)  # type: ignore[arg-type]
         if slot == 'obstacles':

@@ -438,8 +438,7 @@ def _check_required_clearance(result: Plan) -> None:
     else:
         return
     a, b = certificate.indices
-    what = (f'robots {a} and {b}' if certificate.kind == 'robots'
-            else f'robot {a} and {{obstacle}}')
+    what = '{robots}' if certificate.kind == 'robots' else '{robot} and {obstacle}'
     segment = result.segment_of(certificate.leg)
     raise PlanningError(
         ErrorCode.CLEARANCE_BELOW_REQUIRED,
@@ -466,7 +465,7 @@ def _check_inside(result: Plan) -> None:
     centre = float(ends.max() if worst.wall.high else ends.min())
     raise PlanningError(
         ErrorCode.OUTSIDE_WORKSPACE,
-        f'the plan takes robot {worst.body} '
+        'the plan takes {robot} '
         f'{worst.words(bounds, centre, workspace.robot_radius, "robot_radius")} on leg {leg} '
         f'({result.leg_names[leg]} of segment {{waypoint}} -> {{next_waypoint}})',
         configuration=result.segment_of(leg), robots=[worst.body], wall=worst.wall,

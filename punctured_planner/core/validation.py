@@ -55,7 +55,7 @@ def _reject_out_of_range(configurations, first=0):
         return False
     m, robot, axis = (0, *where) if configurations.ndim == 2 else where
     raise PlanningError(ErrorCode.INVALID_REQUEST,
-                        f'{{configuration}}, robot {robot}: coordinate {axis} is '
+                        f'{{configuration}}, {{robot}}: coordinate {axis} is '
                         f'{configurations[where]:.6g}, beyond the supported range '
                         f'+-{MAX_COORDINATE:.0e}', configuration=first + m, robots=[robot],
                         coordinate=axis)
@@ -210,7 +210,7 @@ def validate_configurations(configurations: npt.ArrayLike, obstacles: np.ndarray
     if bad is not None:
         m, robot, axis = bad
         raise PlanningError(ErrorCode.NON_FINITE_VALUE,
-                            f'{{configuration}}, robot {robot}: coordinate {axis} is '
+                            f'{{configuration}}, {{robot}}: coordinate {axis} is '
                             f'{checked[m, robot, axis]}', configuration=m, robots=[robot],
                             coordinate=axis)
     coincident, on_point = _coincidences(checked, obstacles)
@@ -225,27 +225,27 @@ def validate_configurations(configurations: npt.ArrayLike, obstacles: np.ndarray
     if robots is not None and robots is coincident:
         both = [coincident.first, coincident.second]
         raise PlanningError(ErrorCode.ROBOTS_COINCIDE,
-                            f'{{configuration}}: robots {both[0]} and {both[1]} are at the same '
+                            f'{{configuration}}: {{robots}} are at the same '
                             f'point {checked[coincident.configuration, both[0]].tolist()}',
                             configuration=coincident.configuration, robots=both)
     if robots is not None:  # the overlap
         apart, least = compared(robots.distance, 2 * robot_radius)
         raise PlanningError(ErrorCode.ROBOTS_COINCIDE,
-                            f'{{configuration}}: the discs of robots {robots.first} and '
-                            f'{robots.second} overlap: centres {apart} apart, less than 2 '
+                            f'{{configuration}}: the discs of {{robots}} overlap: centres '
+                            f'{apart} apart, less than 2 '
                             f'robot_radius = {least}', configuration=robots.configuration,
                             robots=[robots.first, robots.second])
     touching = _first_of(on_point, on_obstacle)
     if touching is not None and touching is on_point:
         raise PlanningError(ErrorCode.ROBOT_ON_OBSTACLE,
-                            f'{{configuration}}: robot {on_point.first} is on {{obstacle}}',
+                            '{configuration}: {robot} is on {obstacle}',
                             configuration=on_point.configuration, robots=[on_point.first],
                             obstacle=on_point.second, point=obstacles[on_point.second].tolist())
     if touching is not None:  # the overlap
         obstacle = touching.second
         apart, least = compared(touching.distance, robot_radius + obstacle_radii[obstacle])
         raise PlanningError(ErrorCode.ROBOT_ON_OBSTACLE,
-                            f'{{configuration}}: robot {touching.first} overlaps '
+                            f'{{configuration}}: {{robot}} overlaps '
                             f'{{obstacle}}: centres {apart} apart, less than robot_radius + '
                             f'obstacle_radius = {least}',
                             configuration=touching.configuration, robots=[touching.first],
@@ -270,7 +270,7 @@ def _reject_outside(configurations, bounds, robot_radius):
         return
     m, robot, axis = outside.index, outside.body, outside.wall.axis
     raise PlanningError(ErrorCode.OUTSIDE_WORKSPACE,
-                        f'{{configuration}}: robot {robot} is '
+                        '{configuration}: {robot} is '
                         + outside.words(bounds, configurations[m, robot, axis], robot_radius,
                                         'robot_radius'),
                         configuration=m, robots=[robot], wall=outside.wall,

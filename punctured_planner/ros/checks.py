@@ -274,9 +274,8 @@ def _check_range(settings: PlannerSettings, points: np.ndarray, counts: list[int
     m = bisect.bisect_right(ends, row)  # the first offender's configuration, then its robot
     robot = row - (ends[m - 1] if m else 0)
     raise PlanningError(
-        ErrorCode.INVALID_REQUEST, '{configuration}, robot %d: %s = %.6g is beyond '
-        'the supported range +-%.0e' % (robot, axis_name(axis), float(points[far]),
-                                        MAX_COORDINATE),
+        ErrorCode.INVALID_REQUEST, '{configuration}, {robot}: %s = %.6g is beyond '
+        'the supported range +-%.0e' % (axis_name(axis), float(points[far]), MAX_COORDINATE),
         configuration=m, robots=[robot], coordinate=axis)
 
 
@@ -320,8 +319,8 @@ def _check_non_finite(positions: np.ndarray) -> None:
     bad = first_non_finite(positions)
     if bad is not None:
         m, robot, axis = bad
-        raise PlanningError(ErrorCode.NON_FINITE_VALUE, '{configuration}, robot %d: %s is %r'
-                            % (robot, axis_name(axis), float(positions[bad])),
+        raise PlanningError(ErrorCode.NON_FINITE_VALUE, '{configuration}, {robot}: %s is %r'
+                            % (axis_name(axis), float(positions[bad])),
                             configuration=m, robots=[robot], coordinate=axis)
 
 
@@ -369,8 +368,8 @@ def _check_plane(settings: PlannerSettings, positions: np.ndarray) -> None:
     off = np.abs(positions[..., 2] - settings.plane_z) > PLANE_TOLERANCE
     if off.any():
         m, robot = (int(i) for i in np.argwhere(off)[0])
-        raise PlanningError(ErrorCode.OFF_PLANE, '{configuration}, robot %d: z = %r but '
-                            'plane_z is %r (dimension 2)' % (robot, float(positions[m, robot, 2]),
+        raise PlanningError(ErrorCode.OFF_PLANE, '{configuration}, {robot}: z = %r but '
+                            'plane_z is %r (dimension 2)' % (float(positions[m, robot, 2]),
                                                              settings.plane_z),
                             configuration=m, robots=[robot], coordinate=2)
 

@@ -123,7 +123,8 @@ class PlanSequenceHandler:
             label = (gathered.label if gathered is not None else functools.partial(
                 checks.configuration_label, checks.requested_state(request, snapshot)))
             names = RequestNames(snapshot.obstacles.name, label,
-                                 checked.planned if checked is not None else None)
+                                 checked.planned if checked is not None else None,
+                                 snapshot.settings.robot_names)
             conversions.fill_error(response, error.code, error.describe(names),
                                    time.perf_counter() - started, error.clearance, error.gap)
             return Outcome(response=response)

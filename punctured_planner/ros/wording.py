@@ -47,14 +47,36 @@ class ObstacleNames(WallNames):
 
 
 class RequestNames(ObstacleNames):
-    """Configurations by their label in the request, obstacles as :class:`ObstacleNames`."""
+    """
+    Configurations by their label in the request, obstacles as :class:`ObstacleNames`.
+
+    Robots by their index and, with robot_names, their name: 'robot 3 (ghost)'.
+    """
 
     def __init__(self, name: Callable[[int], str], label: Callable[[int], str],
-                 planned: Sequence[int] | None = None) -> None:
-        """label(m) names request configuration m; planned[i] is the i-th planned one's m."""
+                 planned: Sequence[int] | None = None, robots: Sequence[str] = ()) -> None:
+        """
+        Name configurations, obstacles and robots.
+
+        label(m) names request configuration m; planned[i] is the i-th planned one's m;
+        robots[i] is robot i's name (robot_names; empty: none).
+        """
         super().__init__(name)
         self._label = label
         self._planned = planned
+        self._robot_names = tuple(robots)
+
+    def _named(self, i: int) -> str:
+        """Return ' (name)' for robot i when it has one, else ''."""
+        return ' (%s)' % self._robot_names[i] if i < len(self._robot_names) else ''
+
+    def robot(self, i: int) -> str:
+        """Return 'robot 3 (ghost)', or 'robot 3' without robot_names."""
+        return super().robot(i) + self._named(i)
+
+    def robots(self, indices: tuple[int, ...]) -> str:
+        """Return 'robots 0 (r0) and 3 (r3)', or 'robots 0 and 3' without robot_names."""
+        return 'robots ' + ' and '.join('%d%s' % (i, self._named(i)) for i in indices)
 
     def _request_index(self, m: int) -> int:
         return m if self._planned is None else self._planned[m]
