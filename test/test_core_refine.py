@@ -261,3 +261,32 @@ def test_the_configurations_knots_have_no_room_to_move():
     from punctured_planner.core.refine import _knot_caps, KNOTS
     caps = _knot_caps(np.ones((2 * KNOTS, 3)))
     assert np.all(caps[::KNOTS] == 0.0) and np.all(caps[1:KNOTS] == 1.0)
+
+
+def _block_of(pair, pillar, lower=None, shape=(5, 2, 2)):
+    """Return a refinement block whose caps are these constants: (N knots, k robots, d)."""
+    from types import SimpleNamespace
+
+    from punctured_planner.core.refine import _Block
+    n, k, d = shape
+    walls = None if lower is None else np.full(shape, lower)
+    caps = SimpleNamespace(pair=np.full((n, k), pair), pillar=np.full((n, k), pillar),
+                           lower=walls, upper=walls)
+    return _Block(caps, 10.0)
+
+
+def test_a_blocks_common_and_own_moves_together_keep_the_pillar_cap():
+    """The lemma's premise: |common + own| <= the pillar cap, whatever the fleet wants."""
+    wanted = np.zeros((2, 2, 5))
+    wanted[0] = 1.0
+    wanted[0, 0] += 0.5
+    common, own = _block_of(10.0, 1.0).clip(wanted)
+    assert np.all(np.linalg.norm(common + own, axis=0) <= 1.0 + 1e-12)
+
+
+def test_a_blocks_common_and_own_moves_together_keep_the_walls_range():
+    """Per axis, common + own stays within each robot's range towards each wall."""
+    wanted = np.zeros((2, 2, 5))
+    wanted[0] = 1.0
+    common, own = _block_of(10.0, 10.0, lower=0.3).clip(wanted)
+    assert np.all(common + own <= 0.3 + 1e-12) and np.all(common + own >= -0.3 - 1e-12)
