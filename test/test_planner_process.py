@@ -158,3 +158,34 @@ def test_a_path_subscriber_with_incompatible_qos_is_warned_about(planner_process
     assert ros_client.spin_until(lambda: warning in node.log(), 20), node.log()
     assert 'Last incompatible policy: DEADLINE' in node.log()
     assert node.stop() == 0, node.log()
+
+
+def test_plans_answered_in_a_burst_all_reach_a_reader_of_plan(planner_process, ros_client):
+    """
+    Ten requests at once, every other one a large plan: a depth-16 reader gets all ten.
+
+    plan kept one message: a large plan still going out when the next was written was
+    dropped for every reader (4 of 10 such plans; a goal for one ended NO_PLAN although
+    its caller had it). plan_executor reads plan with that depth (ros.goals.PLAN_HISTORY).
+    """
+    from punctured_planner.ros.goals import PLAN_HISTORY
+    from punctured_planner.ros.qos import latched
+    from punctured_planner_interfaces.msg import Plan
+    from punctured_planner_interfaces.srv import PlanSequence
+    node = planner_process(params_file=SCENARIO)
+    heard = []
+    ros_client.node.create_subscription(Plan, node.name('plan'),
+                                        lambda m: heard.append(m.plan_id),
+                                        latched(PLAN_HISTORY))
+    client = ros_client.node.create_client(PlanSequence, node.name('plan_sequence'))
+    ros_client.wait_for_service(client)
+    requests = []
+    for i in range(10):
+        request = example_request()
+        request.samples_per_leg = 300 if i % 2 == 0 else 0
+        requests.append(request)
+    sent = [client.call_async(request) for request in requests]
+    assert ros_client.spin_until(lambda: all(f.done() for f in sent), 120), node.log()
+    assert all(f.result().error_code == 0 for f in sent)
+    answered = {f.result().plan_id for f in sent}
+    assert ros_client.spin_until(lambda: answered <= set(heard), 60), (answered, heard)

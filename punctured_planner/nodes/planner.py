@@ -73,6 +73,8 @@ from ..ros import publications
 from ..ros.parameters import NodeParameters
 from ..ros.planning import PlanSequenceHandler
 from ..ros.planning import refuse_stopping
+from ..ros.goals import PLAN_HISTORY
+from ..ros.qos import latched
 from ..ros.qos import LATCHED
 from ..ros.qos import SERVER_QOS
 from ..ros.qos import STATE
@@ -454,7 +456,11 @@ class PlannerNode(Node):
         """Return the latched publisher of a relative topic (on the outputs node), made once."""
         publisher = self._latched_publishers.get(topic)
         if publisher is None:
-            publisher = self.outputs.create_publisher(msg_type, topic, LATCHED)
+            # plan keeps as many plans as plan_executor does: a writer that kept one dropped
+            # a large plan still going out when the next was written, and no reader got it
+            # (4 of 10 answered plans in a burst; the rest, each robot's latest, keep one).
+            publisher = self.outputs.create_publisher(
+                msg_type, topic, latched(PLAN_HISTORY) if msg_type is Plan else LATCHED)
             self._latched_publishers[topic] = publisher
         return publisher
 
