@@ -70,12 +70,12 @@ from ..core import PlanningError
 from ..core.errors import counted
 from ..ros import conversions
 from ..ros import publications
+from ..ros.goals import PLAN_HISTORY
 from ..ros.parameters import NodeParameters
 from ..ros.planning import PlanSequenceHandler
 from ..ros.planning import refuse_stopping
-from ..ros.goals import PLAN_HISTORY
-from ..ros.qos import latched
 from ..ros.qos import LATCHED
+from ..ros.qos import latched
 from ..ros.qos import SERVER_QOS
 from ..ros.qos import STATE
 from ..ros.runtime import companion
