@@ -185,6 +185,8 @@ def faulty_plan(fault, **fields):
         message.paths = message.paths[:3]
     elif fault == 'name':
         message.robot_names = ['1bad'] + message.robot_names[1:]
+    elif fault == 'long name':  # a valid relative name, too long a topic in most namespaces
+        message.robot_names = ['r' * 240] + message.robot_names[1:]
     elif fault == 'twice':
         message.robot_names = ['robot_0'] * 4
     elif fault == 'nan':

@@ -513,6 +513,40 @@ def test_a_goal_for_a_plan_that_is_no_plan_ends_at_once_saying_why(ros_client, l
         ros_client.node.destroy_publisher(publisher)
 
 
+def test_a_plan_whose_robot_topics_rcl_refuses_is_ignored_saying_why(ros_client,
+                                                                     lone_executor):
+    """
+    A robot named with 240 characters: its topics are too long here; the plan is no plan.
+
+    plan_executor subscribed to its odometry as the plan came: rcl's exception ended the
+    node (exit 1), the waiting goal lost its result, and a restart crashed again on the
+    latched plan.
+    """
+    from planner_helpers import faulty_plan
+    from punctured_planner.ros.qos import LATCHED
+    from punctured_planner_interfaces.action import ExecutePlan
+    from punctured_planner_interfaces.msg import Plan
+    executor, action = lone_executor
+    publisher = ros_client.node.create_publisher(Plan, executor.name('plan'), LATCHED)
+    try:
+        sent = action.send_goal_async(ExecutePlan.Goal(plan_id=7))
+        assert ros_client.spin_until(sent.done, 10) and sent.result().accepted
+        message = faulty_plan('long name')
+        message.plan_id = 7
+        publisher.publish(message)
+        result = sent.result().get_result_async()
+        assert ros_client.spin_until(result.done, 10), executor.log()
+        ended = result.result().result
+        assert ended.error_code == ExecutePlan.Result.NO_PLAN, ended
+        assert "the topics of robot 'rrrr" in ended.error_msg, ended.error_msg
+        assert 'no valid topic names in namespace %s' % executor.name('')[:-1] in \
+            ended.error_msg, ended.error_msg
+        assert executor.proc.poll() is None and 'Traceback' not in executor.log(), \
+            executor.log()
+    finally:
+        ros_client.node.destroy_publisher(publisher)
+
+
 def test_plans_published_back_to_back_are_all_kept(ros_client, lone_executor):
     """
     Eight plans published in a burst are all kept (the planner publishes plans so).

@@ -91,6 +91,7 @@ from ..ros.goals import Lookup
 from ..ros.goals import PLAN_HISTORY
 from ..ros.goals import PlanStore
 from ..ros.parameters import NodeParameters
+from ..ros.parameters import robot_topics_refused
 from ..ros.qos import COMMANDS
 from ..ros.qos import latched
 from ..ros.qos import STATE
@@ -226,6 +227,12 @@ class PlanExecutor(Node):
         while self._heard:
             heard = self._heard.popleft()
             plan = heard.plan
+            refused = [] if plan is None else [
+                why for why in (robot_topics_refused(self, name) for name in plan.names) if why]
+            if refused:  # a name rcl refuses here crashed the node as it subscribed
+                heard = HeardPlan(heard.plan_id, None,
+                                  'plan %d: %s' % (heard.plan_id, refused[0]))
+                plan = None
             if plan is None:
                 self.get_logger().error('plan %d ignored: %s' % (heard.plan_id, heard.problem))
                 self._plans.ignore(heard.plan_id, heard.problem)

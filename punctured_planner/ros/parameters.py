@@ -458,26 +458,19 @@ class NodeParameters(Generic[S]):
         """
         Raise InvalidParameter for a robot name whose topics rcl refuses in the namespace.
 
-        Of the parameters names (those set; all at declaration) that hold robot names.
-
-        A relative name (ros_names) can still make a topic longer than rcl allows (247
-        characters) once the node's namespace is put before it: refused here, in on-set
-        and at declaration, before any subscription is replaced.
+        Of the parameters names (those set; all at declaration) that hold robot names:
+        refused in on-set and at declaration, before any subscription is replaced
+        (robot_topics_refused).
         """
         for name in names:
             spec = self._table.by_name.get(name)
             if spec is None or spec.check is not ros_names:
                 continue
             for index, robot in enumerate(getattr(settings, spec.name)):
-                try:
-                    self._node.resolve_topic_name(robot_topic(robot, _LONGEST_ROBOT_TOPIC))
-                except Exception as error:  # noqa: B902 - rclpy's RCLError, not exported
-                    raise InvalidParameter(spec.name, '%s[%d]: the topics of robot %r are '
-                                           'no valid topic names in namespace %s: %s'
-                                           % (spec.name, index, robot,
-                                              self._node.get_namespace(),
-                                              rcl_reason(error)),
-                                           index=index) from None
+                refused = robot_topics_refused(self._node, robot)
+                if refused:
+                    raise InvalidParameter(spec.name, '%s[%d]: %s' % (spec.name, index, refused),
+                                           index=index)
 
     def _after_set(self, parameters: list) -> None:
         """Take the accepted values into the settings and the node."""
@@ -498,6 +491,23 @@ class NodeParameters(Generic[S]):
 
 # The longest of a robot's topic names (ros.topics): if it resolves, every one does.
 _LONGEST_ROBOT_TOPIC = max(ROBOT_TOPICS, key=len)
+
+
+def robot_topics_refused(node: Any, robot: str) -> str:
+    """
+    Return why rcl refuses the topics of robot in node's namespace, '' when it takes them.
+
+    A relative name (ros_names) can still make a topic longer than rcl allows (247
+    characters) once the node's namespace is put before it.
+    """
+    try:
+        node.resolve_topic_name(robot_topic(robot, _LONGEST_ROBOT_TOPIC))
+    except Exception as error:  # noqa: B902 - rclpy's RCLError, not exported
+        return ('the topics of robot %r are no valid topic names in namespace %s: %s'
+                % (robot, node.get_namespace(), rcl_reason(error)))
+    return ''
+
+
 # The section names that stand for any node (and, '**', any namespace too).
 _WILDCARDS = ('*', '**')
 # Parameters rclpy declares on every node: a file may set them; they are not ours.
