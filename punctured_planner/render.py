@@ -25,8 +25,8 @@ from .viz.animation import MAX_FPS, MAX_SECONDS, MIN_FPS
 MIN_DPI, MAX_DPI = 10, 1000
 
 
-def _at_most(high, low=0.0):
-    """Return an argparse type: a positive finite float at most high (and at least low)."""
+def _within(high, low=0.0):
+    """Return an argparse type: a positive finite float at most high and at least low."""
     def value_of(text):
         value = positive_float(text)
         if value > high:
@@ -63,10 +63,10 @@ def add_render_arguments(parser: argparse.ArgumentParser) -> argparse._ArgumentG
                        help='draw the plan (paths, lanes, waypoints, domain, clearance)')
     group.add_argument('--gif', metavar='OUT.gif', type=_file_of('.gif', 'the animation'),
                        help='animate the synchronous motion of all robots')
-    group.add_argument('--gif-fps', type=_at_most(MAX_FPS, MIN_FPS), default=20.0,
+    group.add_argument('--gif-fps', type=_within(MAX_FPS, MIN_FPS), default=20.0,
                        help='frames per second of the animation, from 1/60 to 50 '
                        '(default: %(default)s)')
-    group.add_argument('--gif-seconds', type=_at_most(MAX_SECONDS), default=8.0,
+    group.add_argument('--gif-seconds', type=_within(MAX_SECONDS), default=8.0,
                        help='length of the animation in seconds, at most 60 '
                        '(default: %(default)s)')
     group.add_argument('--gif-dpi', type=_dpi, default=80.0,

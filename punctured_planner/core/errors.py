@@ -119,13 +119,17 @@ class Names:
         """Return the name of configuration m as a waypoint of the plan: C_{m+1}."""
         return f'C_{m + 1}'
 
+    def robot_label(self, i: int) -> str:
+        """Return what follows 'robot' in robot i's name: its index."""
+        return str(i)
+
     def robot(self, i: int) -> str:
         """Return the name of robot i: 'robot 3'."""
-        return f'robot {i}'
+        return 'robot ' + self.robot_label(i)
 
     def robots(self, indices: tuple[int, ...]) -> str:
         """Return the name of several robots: 'robots 0 and 3'."""
-        return 'robots ' + ' and '.join(str(i) for i in indices)
+        return 'robots ' + ' and '.join(self.robot_label(i) for i in indices)
 
     def obstacle(self, j: int, point: Any = None) -> str:
         """Return the name of obstacle j, with its position when the error carries it."""

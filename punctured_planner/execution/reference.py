@@ -86,7 +86,7 @@ class Reference:
         if self.profile is not None:
             top_speed, top_acceleration = self.profile.max_speed, self.profile.max_acceleration
         else:
-            top_speed, top_acceleration = self.top_speed(), np.inf
+            top_speed, top_acceleration = self._top_speed(), np.inf
         if self.profile is None and not (np.isfinite(accelerations).all() and top_speed > 0):
             moves = np.linalg.norm(np.diff(self.positions, axis=0), axis=2)
             slowest = (moves / speeds).max(axis=1, initial=0.0)
@@ -97,7 +97,7 @@ class Reference:
                                 np.minimum(accelerations, top_acceleration), tolerance, stops)
         return Reference(profile.stamps(), self.positions, self.orientations, profile)
 
-    def top_speed(self) -> float:
+    def _top_speed(self) -> float:
         """Return the fastest any robot moves over an interval (m/s): a linear plan's limit."""
         moves = np.linalg.norm(np.diff(self.positions, axis=0), axis=2).max(axis=1, initial=0.0)
         durations = np.diff(self.seconds)

@@ -209,11 +209,21 @@ class PlanExecutor(Node):
     # ------------------------------------------------------------ inputs
 
     def _on_plan(self, msg: Plan) -> None:
-        """In the plans' thread: convert a published plan and hand it to the node."""
+        """
+        In the plans' thread: convert a published plan and hand it to the node.
+
+        A plan whose robot topics rcl refuses in this namespace is no plan: subscribing
+        to them raised, which ended the node.
+        """
         try:
-            heard = HeardPlan(msg.plan_id, conversions.known_plan(msg))
+            plan = conversions.known_plan(msg)
         except InvalidPlan as error:
             heard = HeardPlan(msg.plan_id, None, str(error))
+        else:
+            refused = next(filter(None, (robot_topics_refused(self.plans, name)
+                                         for name in plan.names)), '')
+            heard = (HeardPlan(msg.plan_id, None, 'plan %d: %s' % (msg.plan_id, refused))
+                     if refused else HeardPlan(msg.plan_id, plan))
         self._heard.append(heard)
         self._plans_heard.trigger()
 
@@ -227,12 +237,6 @@ class PlanExecutor(Node):
         while self._heard:
             heard = self._heard.popleft()
             plan = heard.plan
-            refused = [] if plan is None else [
-                why for why in (robot_topics_refused(self, name) for name in plan.names) if why]
-            if refused:  # a name rcl refuses here crashed the node as it subscribed
-                heard = HeardPlan(heard.plan_id, None,
-                                  'plan %d: %s' % (heard.plan_id, refused[0]))
-                plan = None
             if plan is None:
                 self.get_logger().error('plan %d ignored: %s' % (heard.plan_id, heard.problem))
                 self._plans.ignore(heard.plan_id, heard.problem)

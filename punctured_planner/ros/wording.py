@@ -66,17 +66,9 @@ class RequestNames(ObstacleNames):
         self._planned = planned
         self._robot_names = tuple(robots)
 
-    def _named(self, i: int) -> str:
-        """Return ' (name)' for robot i when it has one, else ''."""
-        return ' (%s)' % self._robot_names[i] if i < len(self._robot_names) else ''
-
-    def robot(self, i: int) -> str:
-        """Return 'robot 3 (ghost)', or 'robot 3' without robot_names."""
-        return super().robot(i) + self._named(i)
-
-    def robots(self, indices: tuple[int, ...]) -> str:
-        """Return 'robots 0 (r0) and 3 (r3)', or 'robots 0 and 3' without robot_names."""
-        return 'robots ' + ' and '.join('%d%s' % (i, self._named(i)) for i in indices)
+    def robot_label(self, i: int) -> str:
+        """Return '3 (ghost)' for robot 3 named ghost, or '3' without robot_names."""
+        return '%d (%s)' % (i, self._robot_names[i]) if i < len(self._robot_names) else str(i)
 
     def _request_index(self, m: int) -> int:
         return m if self._planned is None else self._planned[m]
